@@ -1,0 +1,248 @@
+//! Command-line parsing and the non-interactive commands. The exit code is chosen here, once:
+//! 0 for success (a closed output pipe included), 1 for a failure while running, 2 for bad
+//! input (clap's own usage errors are 2 as well).
+
+use std::fs::File;
+use std::io::{self, BufWriter, IsTerminal, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use glam::Vec3;
+use raytty::{CellGrid, ColorMode, PointLight, Scene, Stage, cornell_box, encode_text, render};
+
+/// Renders the Cornell box (or another scene) by ray tracing, in the terminal.
+///
+/// With no command on a terminal, raytty runs the interactive app; when stdout is not a
+/// terminal it prints one frame, as `raytty render` would. Frames are truecolor half-blocks:
+/// each cell shows two pixels, so an 80×24 frame is 80×48 pixels.
+#[derive(Parser, Debug)]
+#[command(name = "raytty", version, about, long_about)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render one frame to stdout or a file (text frames or images).
+    Render(RenderArgs),
+}
+
+/// Output formats of `raytty render`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Format {
+    /// Truecolor half-blocks (24-bit SGR).
+    Ansi,
+    /// xterm 256-colour half-blocks.
+    Ansi256,
+    /// Plain ASCII luminance ramp, no escapes.
+    Ascii,
+    /// 8-bit PNG image (clamped linear values, no gamma).
+    Png,
+    /// Linear float PFM image.
+    Pfm,
+}
+
+/// Options of `raytty render`.
+#[derive(Args, Debug)]
+struct RenderArgs {
+    /// Frame size in terminal cells, COLSxROWS (text formats: COLS × 2·ROWS pixels).
+    #[arg(long, value_name = "COLSxROWS", value_parser = parse_size, default_value = "80x24")]
+    size: (u32, u32),
+    /// Image size in pixels, WxH (default 500x500 for png and pfm; overrides --size).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pixels: Option<(u32, u32)>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Ansi)]
+    format: Format,
+    /// Shading stage: flat, light, direct, shadows, indirect (the default) or gi.
+    #[arg(long, value_parser = parse_stage, default_value = "indirect")]
+    stage: Stage,
+    /// Camera position and yaw in degrees, x,y,z,yaw (default: the scene's camera).
+    #[arg(long, value_name = "X,Y,Z,YAW", value_parser = parse_camera, allow_hyphen_values = true)]
+    camera: Option<[f32; 4]>,
+    /// Light position x,y,z (default: the scene's first light).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    light: Option<Vec3>,
+    /// Write to FILE instead of stdout.
+    #[arg(short, long, value_name = "FILE")]
+    output: Option<PathBuf>,
+}
+
+/// Most pixels `--pixels` may ask for: about 48 bytes each (float image, cached hits, 8-bit
+/// copy, encoder buffers), so 64 Mpixel stays near 3 GiB.
+const MAX_PIXELS: u64 = 64 * 1024 * 1024;
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let bad = || {
+        format!(
+            "'{s}' is not a size: expected WIDTHxHEIGHT with whole numbers from 1 to 65535, e.g. 80x24"
+        )
+    };
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let w: u32 = w.trim().parse().map_err(|_| bad())?;
+    let h: u32 = h.trim().parse().map_err(|_| bad())?;
+    if w == 0 || h == 0 || w > 65535 || h > 65535 {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
+fn parse_stage(s: &str) -> Result<Stage, String> {
+    Stage::from_name(s).ok_or_else(|| {
+        let names: Vec<_> = Stage::ALL.iter().map(|s| s.name()).collect();
+        format!("'{s}' is not a stage: expected one of {}", names.join(", "))
+    })
+}
+
+fn parse_floats<const N: usize>(s: &str, what: &str) -> Result<[f32; N], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != N {
+        return Err(format!(
+            "'{s}' is not {what}: expected {N} comma-separated numbers"
+        ));
+    }
+    let mut out = [0.0f32; N];
+    for (o, p) in out.iter_mut().zip(parts) {
+        *o = p
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{p}' in '{s}' is not a number"))?;
+        if !o.is_finite() || o.abs() > 1e6 {
+            return Err(format!(
+                "'{p}' in '{s}' is out of range: expected a finite number within ±1e6"
+            ));
+        }
+    }
+    Ok(out)
+}
+
+fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    parse_floats::<3>(s, "a position x,y,z").map(Vec3::from)
+}
+
+fn parse_camera(s: &str) -> Result<[f32; 4], String> {
+    parse_floats::<4>(s, "a camera x,y,z,yaw_degrees")
+}
+
+/// Parses the command line, runs it, and maps the outcome to an exit code.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Render(args)) => run_render(&args),
+        None => run_default(),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("raytty: {e:#}");
+            ExitCode::from(if e.downcast_ref::<UsageError>().is_some() {
+                2
+            } else {
+                1
+            })
+        }
+    }
+}
+
+/// An error in what the user asked for (exit status 2).
+#[derive(Debug)]
+pub struct UsageError(pub String);
+
+impl std::fmt::Display for UsageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for UsageError {}
+
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<io::Error>()
+            .is_some_and(|e| e.kind() == io::ErrorKind::BrokenPipe)
+    })
+}
+
+/// No command: one frame to stdout, as `raytty render` with its defaults.
+fn run_default() -> Result<()> {
+    run_render(&RenderArgs {
+        size: (80, 24),
+        pixels: None,
+        format: if std::env::var_os("NO_COLOR").is_some() {
+            Format::Ascii
+        } else {
+            Format::Ansi
+        },
+        stage: Stage::Indirect,
+        camera: None,
+        light: None,
+        output: None,
+    })
+}
+
+fn run_render(args: &RenderArgs) -> Result<()> {
+    let scene = cornell_box();
+    let image_format = matches!(args.format, Format::Png | Format::Pfm);
+    let (w, h) = match (args.pixels, image_format) {
+        (Some(p), _) => p,
+        (None, true) => (500, 500),
+        (None, false) => (args.size.0, args.size.1 * 2),
+    };
+    let pixels = w as u64 * h as u64;
+    if pixels > MAX_PIXELS {
+        bail!(UsageError(format!(
+            "--pixels {w}x{h} is {pixels} pixels, about {} MiB of memory; the limit is {MAX_PIXELS} pixels (e.g. 8192x8192)",
+            pixels * 48 / (1024 * 1024)
+        )));
+    }
+    let mut camera = scene.camera;
+    if let Some([x, y, z, yaw]) = args.camera {
+        camera.position = Vec3::new(x, y, z);
+        camera.yaw = yaw.to_radians();
+    }
+    let lights = lights_with(&scene, args.light);
+    let settings = args.stage.settings(scene.effects);
+    let frame = render(&scene, &camera, &lights, &settings, w, h);
+
+    let mut out: Box<dyn Write> = match &args.output {
+        Some(path) => Box::new(BufWriter::new(
+            File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
+        )),
+        None => {
+            if image_format && io::stdout().is_terminal() {
+                bail!(UsageError(format!(
+                    "--format {:?} writes binary data: give -o FILE or redirect stdout",
+                    args.format
+                )));
+            }
+            Box::new(BufWriter::new(io::stdout().lock()))
+        }
+    };
+    match args.format {
+        Format::Png => frame.image.write_png(&mut out)?,
+        Format::Pfm => frame.image.write_pfm(&mut out)?,
+        Format::Ansi | Format::Ansi256 | Format::Ascii => {
+            let mode = match args.format {
+                Format::Ansi => ColorMode::TrueColor,
+                Format::Ansi256 => ColorMode::Ansi256,
+                _ => ColorMode::Ascii,
+            };
+            out.write_all(&encode_text(&CellGrid::from_image(&frame.image, mode)))?;
+        }
+    }
+    out.flush()?;
+    Ok(())
+}
+
+/// The scene's lights, with the first one moved to `light` if given.
+fn lights_with(scene: &Scene, light: Option<Vec3>) -> Vec<PointLight> {
+    let mut lights = scene.lights.clone();
+    if let (Some(p), Some(first)) = (light, lights.first_mut()) {
+        first.position = p;
+    }
+    lights
+}

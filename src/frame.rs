@@ -1,0 +1,352 @@
+//! Frame encoding: an image becomes a grid of terminal cells (one cell = two pixels stacked),
+//! and a grid becomes bytes, either as a whole text frame or as the difference from the frame
+//! the terminal already shows. Pure functions: no terminal, no I/O.
+
+use std::io::Write;
+
+use crate::image::Image;
+
+/// How cells are coloured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ColorMode {
+    /// 24-bit colour: `▀` with the upper pixel as foreground and the lower as background.
+    TrueColor,
+    /// The xterm 256-colour palette (6×6×6 cube and grey ramp), nearest colour.
+    Ansi256,
+    /// No escapes at all: one character per cell from a luminance ramp.
+    Ascii,
+}
+
+impl ColorMode {
+    /// The mode's name as the CLI and status line show it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ColorMode::TrueColor => "truecolor",
+            ColorMode::Ansi256 => "256",
+            ColorMode::Ascii => "ascii",
+        }
+    }
+
+    /// The next mode in the cycle truecolor → 256 → ascii → truecolor.
+    pub fn next(self) -> ColorMode {
+        match self {
+            ColorMode::TrueColor => ColorMode::Ansi256,
+            ColorMode::Ansi256 => ColorMode::Ascii,
+            ColorMode::Ascii => ColorMode::TrueColor,
+        }
+    }
+}
+
+/// A terminal colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Colour {
+    /// 24-bit RGB.
+    Rgb(u8, u8, u8),
+    /// An index into the 256-colour palette.
+    Indexed(u8),
+}
+
+/// One terminal cell: a character with optional foreground and background colours.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Cell {
+    /// The character drawn (`▀`, a space, or an ASCII ramp character).
+    pub ch: char,
+    /// Foreground colour, if the character shows one.
+    pub fg: Option<Colour>,
+    /// Background colour, if any.
+    pub bg: Option<Colour>,
+}
+
+/// The upper-half block: its foreground paints the cell's upper pixel.
+pub const UPPER_HALF: char = '▀';
+
+/// The ASCII luminance ramp, darkest first.
+pub const ASCII_RAMP: &[u8] = b" .:-=+*#%@";
+
+/// A grid of cells, row-major.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CellGrid {
+    /// Columns.
+    pub cols: usize,
+    /// Rows.
+    pub rows: usize,
+    /// `cols × rows` cells.
+    pub cells: Vec<Cell>,
+}
+
+impl CellGrid {
+    /// Turns an image of `cols × 2·rows` pixels into `cols × rows` cells. An odd last pixel row
+    /// is paired with black.
+    pub fn from_image(image: &Image, mode: ColorMode) -> CellGrid {
+        let cols = image.width as usize;
+        let rows = (image.height as usize).div_ceil(2);
+        let rgb = image.to_rgb8();
+        let px = |x: usize, y: usize| {
+            if y < image.height as usize {
+                rgb[y * cols + x]
+            } else {
+                [0; 3]
+            }
+        };
+        let mut cells = Vec::with_capacity(cols * rows);
+        for r in 0..rows {
+            for x in 0..cols {
+                let (up, lo) = (px(x, 2 * r), px(x, 2 * r + 1));
+                cells.push(match mode {
+                    ColorMode::TrueColor => half_block(
+                        Colour::Rgb(up[0], up[1], up[2]),
+                        Colour::Rgb(lo[0], lo[1], lo[2]),
+                    ),
+                    ColorMode::Ansi256 => half_block(
+                        Colour::Indexed(nearest_256(up)),
+                        Colour::Indexed(nearest_256(lo)),
+                    ),
+                    ColorMode::Ascii => {
+                        let y = (luminance(up) + luminance(lo)) * 0.5;
+                        let i = (y / 255.0 * (ASCII_RAMP.len() - 1) as f32 + 0.5) as usize;
+                        Cell {
+                            ch: ASCII_RAMP[i.min(ASCII_RAMP.len() - 1)] as char,
+                            fg: None,
+                            bg: None,
+                        }
+                    }
+                });
+            }
+        }
+        CellGrid { cols, rows, cells }
+    }
+
+    /// The cell at (col, row).
+    pub fn get(&self, col: usize, row: usize) -> Cell {
+        self.cells[row * self.cols + col]
+    }
+}
+
+/// A cell showing `up` over `lo`: a space with only a background when the two are equal.
+fn half_block(up: Colour, lo: Colour) -> Cell {
+    if up == lo {
+        Cell {
+            ch: ' ',
+            fg: None,
+            bg: Some(lo),
+        }
+    } else {
+        Cell {
+            ch: UPPER_HALF,
+            fg: Some(up),
+            bg: Some(lo),
+        }
+    }
+}
+
+/// Rec. 709 luminance of an 8-bit colour, 0..=255.
+fn luminance(c: [u8; 3]) -> f32 {
+    0.2126 * c[0] as f32 + 0.7152 * c[1] as f32 + 0.0722 * c[2] as f32
+}
+
+/// The xterm cube's six levels.
+const CUBE: [u8; 6] = [0, 95, 135, 175, 215, 255];
+
+/// The nearest colour of the xterm 256 palette's cube (16-231) and grey ramp (232-255), by
+/// squared RGB distance. The 16 system colours are left out: terminals theme them.
+pub fn nearest_256(c: [u8; 3]) -> u8 {
+    let level = |v: u8| {
+        let mut best = 0;
+        for (i, &l) in CUBE.iter().enumerate() {
+            if (l as i32 - v as i32).abs() < (CUBE[best] as i32 - v as i32).abs() {
+                best = i;
+            }
+        }
+        best
+    };
+    let dist = |a: [u8; 3], b: [u8; 3]| -> i32 {
+        (0..3).map(|i| (a[i] as i32 - b[i] as i32).pow(2)).sum()
+    };
+    let (r, g, b) = (level(c[0]), level(c[1]), level(c[2]));
+    let cube = [CUBE[r], CUBE[g], CUBE[b]];
+    let avg = (c[0] as i32 + c[1] as i32 + c[2] as i32) / 3;
+    let gi = ((avg - 8).max(0) / 10).min(23) as u8;
+    let grey = 8 + 10 * gi;
+    if dist(c, [grey; 3]) < dist(c, cube) {
+        232 + gi
+    } else {
+        16 + 36 * r as u8 + 6 * g as u8 + b as u8
+    }
+}
+
+/// The SGR state the encoder believes the terminal is in.
+#[derive(Clone, Copy, Default)]
+struct Pen {
+    fg: Option<Colour>,
+    bg: Option<Colour>,
+}
+
+impl Pen {
+    /// Writes one SGR sequence that gives `cell`'s colours (only the parts that changed; the
+    /// foreground of a space is left alone), and updates the pen.
+    fn set(&mut self, out: &mut Vec<u8>, cell: &Cell) {
+        let fg = cell.fg.filter(|&c| Some(c) != self.fg);
+        let bg = cell.bg.filter(|&c| Some(c) != self.bg);
+        if fg.is_none() && bg.is_none() {
+            return;
+        }
+        out.extend_from_slice(b"\x1b[");
+        if let Some(c) = fg {
+            write_colour(out, 38, c);
+            self.fg = Some(c);
+        }
+        if let Some(c) = bg {
+            if fg.is_some() {
+                out.push(b';');
+            }
+            write_colour(out, 48, c);
+            self.bg = Some(c);
+        }
+        out.push(b'm');
+    }
+}
+
+fn write_colour(out: &mut Vec<u8>, base: u8, c: Colour) {
+    let _ = match c {
+        Colour::Rgb(r, g, b) => write!(out, "{base};2;{r};{g};{b}"),
+        Colour::Indexed(i) => write!(out, "{base};5;{i}"),
+    };
+}
+
+fn write_char(out: &mut Vec<u8>, ch: char) {
+    let mut buf = [0; 4];
+    out.extend_from_slice(ch.encode_utf8(&mut buf).as_bytes());
+}
+
+/// A whole frame as text for a stream (stdout, a file): rows separated by newlines, each
+/// coloured row ending in a reset so no colour bleeds past it. ASCII frames have no escapes.
+pub fn encode_text(grid: &CellGrid) -> Vec<u8> {
+    let mut out = Vec::with_capacity(grid.cells.len() * 8);
+    for row in grid.cells.chunks(grid.cols.max(1)) {
+        let mut pen = Pen::default();
+        for cell in row {
+            pen.set(&mut out, cell);
+            write_char(&mut out, cell.ch);
+        }
+        if pen.fg.is_some() || pen.bg.is_some() {
+            out.extend_from_slice(b"\x1b[0m");
+        }
+        out.push(b'\n');
+    }
+    out
+}
+
+/// The bytes that turn a screen showing `prev` (or, if `None`, anything) into one showing
+/// `next`, with the grid's top-left at the screen's row `top` (0-based). Unchanged cells are
+/// skipped with cursor moves; colours are set only when they change; the pen is reset at the
+/// end. A `prev` of another size counts as `None`.
+pub fn encode_diff(prev: Option<&CellGrid>, next: &CellGrid, top: usize, out: &mut Vec<u8>) {
+    let prev = prev.filter(|p| p.cols == next.cols && p.rows == next.rows);
+    let mut pen = Pen::default();
+    // Where the terminal's cursor is, if known.
+    let mut cursor: Option<(usize, usize)> = None;
+    let mut wrote = false;
+    for r in 0..next.rows {
+        for c in 0..next.cols {
+            let cell = next.cells[r * next.cols + c];
+            if prev.is_some_and(|p| p.cells[r * p.cols + c] == cell) {
+                continue;
+            }
+            match cursor {
+                Some((cr, cc)) if cr == r && cc == c => {}
+                Some((cr, cc)) if cr == r && cc < c => {
+                    let _ = write!(out, "\x1b[{}C", c - cc);
+                }
+                _ => {
+                    let _ = write!(out, "\x1b[{};{}H", top + r + 1, c + 1);
+                }
+            }
+            pen.set(out, &cell);
+            write_char(out, cell.ch);
+            wrote = true;
+            // Past the last column the cursor position is terminal-dependent: forget it.
+            cursor = (c + 1 < next.cols).then_some((r, c + 1));
+        }
+    }
+    if wrote && (pen.fg.is_some() || pen.bg.is_some()) {
+        out.extend_from_slice(b"\x1b[0m");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    fn image(pixels: &[[f32; 3]], w: u32) -> Image {
+        let pixels: Vec<Vec3> = pixels.iter().map(|&p| Vec3::from(p)).collect();
+        Image {
+            width: w,
+            height: pixels.len() as u32 / w,
+            pixels,
+        }
+    }
+
+    #[test]
+    fn equal_pixels_make_a_space_with_a_background() {
+        let img = image(
+            &[
+                [1.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ],
+            2,
+        );
+        let g = CellGrid::from_image(&img, ColorMode::TrueColor);
+        assert_eq!(g.cells.len(), 2);
+        let text = String::from_utf8(encode_text(&g)).unwrap();
+        assert_eq!(text, "\x1b[48;2;255;0;0m \x1b[48;2;0;0;255m \x1b[0m\n");
+        let img = image(&[[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]], 1);
+        let g = CellGrid::from_image(&img, ColorMode::TrueColor);
+        assert_eq!(
+            g.cells[0],
+            Cell {
+                ch: ' ',
+                fg: None,
+                bg: Some(Colour::Rgb(255, 0, 0))
+            }
+        );
+    }
+
+    #[test]
+    fn colours_are_emitted_only_when_they_change() {
+        let img = image(
+            &[[1.0, 0.0, 0.0]; 6]
+                .iter()
+                .chain(&[[0.0, 1.0, 0.0]; 6])
+                .copied()
+                .collect::<Vec<_>>(),
+            6,
+        );
+        let text = encode_text(&CellGrid::from_image(&img, ColorMode::TrueColor));
+        assert_eq!(
+            String::from_utf8(text).unwrap(),
+            "\x1b[38;2;255;0;0;48;2;0;255;0m▀▀▀▀▀▀\x1b[0m\n"
+        );
+    }
+
+    #[test]
+    fn nearest_256_hits_cube_and_grey() {
+        assert_eq!(nearest_256([0, 0, 0]), 16);
+        assert_eq!(nearest_256([255, 255, 255]), 231);
+        assert_eq!(nearest_256([255, 0, 0]), 196);
+        assert_eq!(nearest_256([128, 128, 128]), 244);
+    }
+
+    #[test]
+    fn diff_of_identical_frames_is_empty() {
+        let img = image(&[[0.3, 0.2, 0.1], [0.9, 0.9, 0.9]], 1);
+        let g = CellGrid::from_image(&img, ColorMode::TrueColor);
+        let mut out = Vec::new();
+        encode_diff(Some(&g), &g, 0, &mut out);
+        assert!(out.is_empty());
+        encode_diff(None, &g, 0, &mut out);
+        assert!(out.starts_with(b"\x1b[1;1H"));
+    }
+}

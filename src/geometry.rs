@@ -1,0 +1,429 @@
+//! Rays, triangles and the watertight ray/triangle test.
+//!
+//! The intersection follows Woop, Benthin and Wald, "Watertight Ray/Triangle Intersection"
+//! (JCGT 2013), with the conservative error bound on `t` that pbrt-v4 adds: a ray that passes
+//! exactly through a shared edge or vertex hits at least one of the triangles that share it, and a
+//! hit is never reported at a distance that rounding error cannot tell from zero. New rays leave a
+//! surface from an origin pushed out of the hit point's own rounding-error box
+//! ([`offset_ray_origin`]), so no tuned epsilon depends on the scene's scale.
+
+use glam::{DVec3, Vec3};
+
+/// Machine epsilon for `f32` rounding: half an ULP of 1.0.
+const MACHINE_EPSILON: f32 = f32::EPSILON * 0.5;
+
+/// Bound on the relative error of `n` chained `f32` operations (Higham's γₙ, as in pbrt).
+#[inline]
+pub fn gamma(n: i32) -> f32 {
+    let n = n as f32 * MACHINE_EPSILON;
+    n / (1.0 - n)
+}
+
+/// The smallest `f32` strictly greater than `v` (identity for +∞ and NaN).
+#[inline]
+pub fn next_float_up(v: f32) -> f32 {
+    if v.is_infinite() && v > 0.0 || v.is_nan() {
+        return v;
+    }
+    let v = if v == -0.0 { 0.0 } else { v };
+    let bits = v.to_bits();
+    let bits = if v >= 0.0 { bits + 1 } else { bits - 1 };
+    f32::from_bits(bits)
+}
+
+/// The largest `f32` strictly less than `v` (identity for −∞ and NaN).
+#[inline]
+pub fn next_float_down(v: f32) -> f32 {
+    if v.is_infinite() && v < 0.0 || v.is_nan() {
+        return v;
+    }
+    let v = if v == 0.0 { -0.0 } else { v };
+    let bits = v.to_bits();
+    let bits = if v > 0.0 { bits - 1 } else { bits + 1 };
+    f32::from_bits(bits)
+}
+
+/// A ray `origin + t·dir`, with the per-ray constants of the watertight test precomputed.
+///
+/// `dir` need not be normalised: `t` is measured in units of `dir`.
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    /// Where the ray starts.
+    pub origin: Vec3,
+    /// Its direction (any non-zero length).
+    pub dir: Vec3,
+    /// Component-wise `1/dir` for slab tests (±∞ where a component is zero).
+    pub inv_dir: Vec3,
+    /// The axis along which `dir` is largest in magnitude, and the two others.
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    /// Shear that maps `dir` onto +z.
+    sx: f32,
+    sy: f32,
+    sz: f32,
+}
+
+impl Ray {
+    /// A ray from `origin` along `dir`. `dir` must be finite and non-zero.
+    pub fn new(origin: Vec3, dir: Vec3) -> Ray {
+        debug_assert!(origin.is_finite() && dir.is_finite(), "ray {origin} {dir}");
+        debug_assert!(dir != Vec3::ZERO, "zero ray direction");
+        let a = dir.abs();
+        let kz = if a.x > a.y {
+            if a.x > a.z { 0 } else { 2 }
+        } else if a.y > a.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if dir[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let sz = 1.0 / dir[kz];
+        Ray {
+            origin,
+            dir,
+            inv_dir: dir.recip(),
+            kx,
+            ky,
+            kz,
+            sx: -dir[kx] * sz,
+            sy: -dir[ky] * sz,
+            sz,
+        }
+    }
+
+    /// The point at parameter `t`.
+    #[inline]
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+}
+
+/// A triangle with its geometric normal and material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// Vertices in the scene's winding order.
+    pub v: [Vec3; 3],
+    /// `normalize(cross(v2 − v0, v1 − v0))`, the seed's convention. Never NaN: a scene only holds
+    /// triangles whose normal is finite and unit length (see [`Triangle::new`]).
+    pub normal: Vec3,
+    /// Index into the scene's material table.
+    pub material: u32,
+}
+
+/// Why a triangle cannot be part of a scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DegenerateTriangle {
+    /// A vertex coordinate is NaN or infinite.
+    NonFinite,
+    /// Zero area (repeated or collinear vertices): it has no normal and can never be hit.
+    ZeroArea,
+}
+
+impl std::fmt::Display for DegenerateTriangle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            DegenerateTriangle::NonFinite => f.write_str("a vertex coordinate is NaN or infinite"),
+            DegenerateTriangle::ZeroArea => {
+                f.write_str("the triangle has zero area (repeated or collinear vertices)")
+            }
+        }
+    }
+}
+
+impl std::error::Error for DegenerateTriangle {}
+
+impl Triangle {
+    /// Builds a triangle, rejecting the degenerate ones: non-finite vertices, or an area so small
+    /// that the normal cannot be computed (the cross product computed in `f64` to avoid
+    /// underflow at tiny scales).
+    pub fn new(
+        v0: Vec3,
+        v1: Vec3,
+        v2: Vec3,
+        material: u32,
+    ) -> Result<Triangle, DegenerateTriangle> {
+        if !(v0.is_finite() && v1.is_finite() && v2.is_finite()) {
+            return Err(DegenerateTriangle::NonFinite);
+        }
+        let c = (v2.as_dvec3() - v0.as_dvec3()).cross(v1.as_dvec3() - v0.as_dvec3());
+        let len = c.length();
+        if !(len > 0.0) || !len.is_finite() {
+            return Err(DegenerateTriangle::ZeroArea);
+        }
+        let normal = (c / len).as_vec3();
+        if !normal.is_finite() || normal == Vec3::ZERO {
+            return Err(DegenerateTriangle::ZeroArea);
+        }
+        Ok(Triangle {
+            v: [v0, v1, v2],
+            normal: normal.normalize(),
+            material,
+        })
+    }
+
+    /// Intersects `ray` with this triangle (both sides), returning a hit with `0 < t < t_max`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<TriHit> {
+        intersect_watertight(ray, &self.v, t_max)
+    }
+}
+
+/// A ray/triangle hit: distance and barycentric weights of the three vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriHit {
+    /// Ray parameter of the hit, always `> 0` and finite.
+    pub t: f32,
+    /// Barycentric weights of `v0`, `v1`, `v2`; each in `[0, 1]`, summing to 1 up to rounding.
+    pub b: [f32; 3],
+}
+
+/// The watertight ray/triangle test. Two-sided. Returns `None` for a miss, for a hit at or
+/// beyond `t_max`, and for a hit whose `t` is within its own rounding error of zero.
+#[inline]
+pub fn intersect_watertight(ray: &Ray, v: &[Vec3; 3], t_max: f32) -> Option<TriHit> {
+    let (kx, ky, kz) = (ray.kx, ray.ky, ray.kz);
+    // Translate to the ray origin, permute so that the ray runs along +z, then shear.
+    let a = v[0] - ray.origin;
+    let b = v[1] - ray.origin;
+    let c = v[2] - ray.origin;
+    let (az, bz, cz) = (a[kz], b[kz], c[kz]);
+    let ax = a[kx] + ray.sx * az;
+    let ay = a[ky] + ray.sy * az;
+    let bx = b[kx] + ray.sx * bz;
+    let by = b[ky] + ray.sy * bz;
+    let cx = c[kx] + ray.sx * cz;
+    let cy = c[ky] + ray.sy * cz;
+
+    // Edge functions; e0 is the weight of vertex 0 (opposite edge b–c), and so on.
+    let mut e0 = bx * cy - by * cx;
+    let mut e1 = cx * ay - cy * ax;
+    let mut e2 = ax * by - ay * bx;
+    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+        // Exactly on an edge in f32: decide in f64, where these products are exact.
+        let (ax, ay, bx, by, cx, cy) = (
+            ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64,
+        );
+        e0 = (bx * cy - by * cx) as f32;
+        e1 = (cx * ay - cy * ax) as f32;
+        e2 = (ax * by - ay * bx) as f32;
+    }
+    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+        return None;
+    }
+    let det = e0 + e1 + e2;
+    if det == 0.0 || det.is_nan() {
+        return None;
+    }
+
+    let az = ray.sz * az;
+    let bz = ray.sz * bz;
+    let cz = ray.sz * cz;
+    let t_scaled = e0 * az + e1 * bz + e2 * cz;
+    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+        return None;
+    }
+    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let t = t_scaled * inv_det;
+    if !(t < t_max) {
+        return None;
+    }
+
+    // Conservative bound on the error of t (pbrt-v4, section 6.8.4): reject hits that rounding
+    // cannot separate from the origin.
+    let max_zt = az.abs().max(bz.abs()).max(cz.abs());
+    let delta_z = gamma(3) * max_zt;
+    let max_xt = ax.abs().max(bx.abs()).max(cx.abs());
+    let max_yt = ay.abs().max(by.abs()).max(cy.abs());
+    let delta_x = gamma(5) * (max_xt + max_zt);
+    let delta_y = gamma(5) * (max_yt + max_zt);
+    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+    let delta_t =
+        3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    if !(t > delta_t) {
+        return None;
+    }
+    Some(TriHit {
+        t,
+        b: [e0 * inv_det, e1 * inv_det, e2 * inv_det],
+    })
+}
+
+/// The hit point from barycentrics, and a conservative bound on its absolute error per axis.
+#[inline]
+pub fn hit_point(v: &[Vec3; 3], b: [f32; 3]) -> (Vec3, Vec3) {
+    let p0 = v[0] * b[0];
+    let p1 = v[1] * b[1];
+    let p2 = v[2] * b[2];
+    let p = p0 + p1 + p2;
+    let err = (p0.abs() + p1.abs() + p2.abs()) * gamma(7);
+    (p, err)
+}
+
+/// Moves `p` (with per-axis error bound `err`) off its surface with normal `n`, to the side that
+/// `w` points to, far enough that a ray from the result cannot re-hit that surface (pbrt-v4's
+/// `OffsetRayOrigin`). The offset is rounded away from `p` so it survives the addition.
+#[inline]
+pub fn offset_ray_origin(p: Vec3, err: Vec3, n: Vec3, w: Vec3) -> Vec3 {
+    let d = n.abs().dot(err);
+    let mut offset = n * d;
+    if w.dot(n) < 0.0 {
+        offset = -offset;
+    }
+    let mut po = p + offset;
+    for i in 0..3 {
+        if offset[i] > 0.0 {
+            po[i] = next_float_up(po[i]);
+        } else if offset[i] < 0.0 {
+            po[i] = next_float_down(po[i]);
+        }
+    }
+    po
+}
+
+/// An axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Smallest corner.
+    pub min: Vec3,
+    /// Largest corner.
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The empty box (min = +∞, max = −∞), the identity of [`Aabb::union`].
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::INFINITY,
+        max: Vec3::NEG_INFINITY,
+    };
+
+    /// The box around a triangle.
+    pub fn of_triangle(t: &Triangle) -> Aabb {
+        Aabb {
+            min: t.v[0].min(t.v[1]).min(t.v[2]),
+            max: t.v[0].max(t.v[1]).max(t.v[2]),
+        }
+    }
+
+    /// The smallest box holding both.
+    pub fn union(self, o: Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
+    }
+
+    /// The box's centre.
+    pub fn centre(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    /// Robust slab test (pbrt-v4): does the ray meet the box for some `t` in `[0, t_max)`?
+    /// The far distance is widened by 2γ₃ so rounding never culls a box the ray grazes.
+    #[inline]
+    pub fn hit(&self, ray: &Ray, t_max: f32) -> bool {
+        let mut t0 = 0.0f32;
+        let mut t1 = t_max;
+        for i in 0..3 {
+            let inv = ray.inv_dir[i];
+            let mut near = (self.min[i] - ray.origin[i]) * inv;
+            let mut far = (self.max[i] - ray.origin[i]) * inv;
+            if near > far {
+                std::mem::swap(&mut near, &mut far);
+            }
+            far *= 1.0 + 2.0 * gamma(3);
+            // NaN (origin on a slab plane of a parallel ray) leaves the interval unchanged.
+            if near > t0 {
+                t0 = near;
+            }
+            if far < t1 {
+                t1 = far;
+            }
+            if t0 > t1 {
+                return false;
+            }
+        }
+        true
+    }
+}
+
+/// The same test in `f64`, for references in tests and tools: plain Möller–Trumbore with no
+/// epsilon, returning `(t, b1, b2)` for hits with `t > 0`.
+pub fn intersect_f64(origin: DVec3, dir: DVec3, v: [DVec3; 3]) -> Option<(f64, f64, f64)> {
+    let e1 = v[1] - v[0];
+    let e2 = v[2] - v[0];
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = origin - v[0];
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let w = dir.dot(q) * inv;
+    if w < 0.0 || u + w > 1.0 {
+        return None;
+    }
+    let t = e2.dot(q) * inv;
+    (t > 0.0).then_some((t, u, w))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn next_float_steps_one_ulp() {
+        assert!(next_float_up(1.0) > 1.0);
+        assert!(next_float_down(1.0) < 1.0);
+        assert!(next_float_up(0.0) > 0.0);
+        assert!(next_float_down(0.0) < 0.0);
+        assert_eq!(next_float_down(next_float_up(2.5)), 2.5);
+    }
+
+    #[test]
+    fn hits_inside_and_misses_outside() {
+        let v = [
+            Vec3::new(-1.0, -1.0, 1.0),
+            Vec3::new(1.0, -1.0, 1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ];
+        let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+        let hit = intersect_watertight(&ray, &v, f32::INFINITY).unwrap();
+        assert!((hit.t - 1.0).abs() < 1e-6);
+        let ray = Ray::new(Vec3::ZERO, Vec3::new(5.0, 0.0, 1.0));
+        assert!(intersect_watertight(&ray, &v, f32::INFINITY).is_none());
+        let ray = Ray::new(Vec3::ZERO, -Vec3::Z);
+        assert!(intersect_watertight(&ray, &v, f32::INFINITY).is_none());
+        let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+        assert!(intersect_watertight(&ray, &v, 0.5).is_none());
+    }
+
+    #[test]
+    fn degenerate_triangles_are_rejected() {
+        let a = Vec3::ZERO;
+        let b = Vec3::X;
+        assert_eq!(Triangle::new(a, a, b, 0), Err(DegenerateTriangle::ZeroArea));
+        assert_eq!(
+            Triangle::new(a, b, 2.0 * b, 0),
+            Err(DegenerateTriangle::ZeroArea)
+        );
+        assert_eq!(
+            Triangle::new(a, b, Vec3::NAN, 0),
+            Err(DegenerateTriangle::NonFinite)
+        );
+        assert!(Triangle::new(a, b, Vec3::Y, 0).is_ok());
+    }
+}

@@ -1,0 +1,38 @@
+//! raytty: a raytracer that lives in the terminal.
+//!
+//! The library is the tracer and the frame encoder; it does no terminal I/O and never imports
+//! crossterm. Data flows scene → camera rays → intersection → shading → [`Image`] →
+//! [`CellGrid`] → bytes:
+//!
+//! ```
+//! use raytty::{cornell_box, render, CellGrid, ColorMode, Stage, encode_text};
+//! let scene = cornell_box();
+//! let settings = Stage::Indirect.settings(scene.effects);
+//! let frame = render(&scene, &scene.camera, &scene.lights, &settings, 40, 24);
+//! let text = encode_text(&CellGrid::from_image(&frame.image, ColorMode::Ascii));
+//! assert_eq!(text.iter().filter(|&&b| b == b'\n').count(), 12);
+//! ```
+#![warn(missing_docs)]
+// `!(a > b)` is how the tracer says "not greater, or NaN": NaN must fall on the safe side.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod accel;
+pub mod camera;
+pub mod cornell;
+pub mod frame;
+pub mod geometry;
+pub mod image;
+pub mod render;
+pub mod rng;
+pub mod scene;
+pub mod shading;
+
+pub use accel::Hit;
+pub use camera::Camera;
+pub use cornell::cornell_box;
+pub use frame::{CellGrid, ColorMode, encode_diff, encode_text};
+pub use geometry::{Ray, Triangle};
+pub use image::Image;
+pub use render::{Frame, FrameStats, HitCache, render, render_cached};
+pub use scene::{Effects, Indirect, Material, PointLight, Scene, SceneBuilder};
+pub use shading::{Mode, RayCounts, Settings, Stage, Tracer};

@@ -1,0 +1,9 @@
+//! The `raytty` command: the interactive app, `render`, and the tools around them.
+
+mod cli;
+
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    cli::main()
+}

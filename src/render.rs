@@ -1,0 +1,191 @@
+//! The render loop: primary rays for every pixel, rows in parallel, shaded by [`Tracer`].
+//!
+//! A frame's pixels depend only on (scene, camera, lights, settings, size): each sample's random
+//! numbers are seeded from (pixel, sample, frame), and the ray counts are integer sums, so the
+//! image and the stats are the same with one thread or many.
+
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use crate::accel::Hit;
+use crate::camera::Camera;
+use crate::image::Image;
+use crate::rng::Rng;
+use crate::scene::{PointLight, Scene};
+use crate::shading::{RayCounts, Settings, Tracer};
+
+/// What a frame cost.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameStats {
+    /// Rays traced by kind.
+    pub rays: RayCounts,
+    /// Samples per pixel.
+    pub samples: u32,
+    /// Wall-clock time of the render.
+    pub elapsed: Duration,
+}
+
+/// A rendered frame.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// The linear image.
+    pub image: Image,
+    /// What it cost.
+    pub stats: FrameStats,
+}
+
+/// The primary hits of the last frame, reused while the camera, size and geometry stay the
+/// same: a frame where only the light (or the stage) changed traces no primary ray.
+#[derive(Clone, Debug, Default)]
+pub struct HitCache {
+    key: Option<(CameraKey, u32, u32)>,
+    hits: Vec<Option<Hit>>,
+}
+
+type CameraKey = ([u32; 3], u32, u32);
+
+fn camera_key(c: &Camera) -> CameraKey {
+    (
+        c.position.to_array().map(f32::to_bits),
+        c.yaw.to_bits(),
+        c.pitch.to_bits(),
+    )
+}
+
+impl HitCache {
+    /// An empty cache.
+    pub fn new() -> HitCache {
+        HitCache::default()
+    }
+
+    /// Forgets the cached hits (call when the scene's geometry changes).
+    pub fn clear(&mut self) {
+        self.key = None;
+        self.hits.clear();
+    }
+}
+
+/// Renders a `width`×`height` frame.
+pub fn render(
+    scene: &Scene,
+    camera: &Camera,
+    lights: &[PointLight],
+    settings: &Settings,
+    width: u32,
+    height: u32,
+) -> Frame {
+    render_cached(
+        scene,
+        camera,
+        lights,
+        settings,
+        width,
+        height,
+        &mut HitCache::new(),
+    )
+}
+
+/// Renders a frame, reusing `cache`'s primary hits when they are still valid (one sample per
+/// pixel, same camera and size) and refilling it otherwise.
+pub fn render_cached(
+    scene: &Scene,
+    camera: &Camera,
+    lights: &[PointLight],
+    settings: &Settings,
+    width: u32,
+    height: u32,
+    cache: &mut HitCache,
+) -> Frame {
+    let start = Instant::now();
+    let samples = settings.effects.samples.max(1);
+    let tracer = Tracer::new(scene, lights, *settings);
+    let rays = camera.rays(width, height);
+    let (w, h) = (width as usize, height as usize);
+    let mut image = Image::new(width, height);
+    if w == 0 || h == 0 {
+        return Frame {
+            image,
+            stats: FrameStats {
+                samples,
+                ..FrameStats::default()
+            },
+        };
+    }
+
+    let key = Some((camera_key(camera), width, height));
+    let counts = if samples == 1 {
+        let reuse = cache.key == key && cache.hits.len() == w * h;
+        if !reuse {
+            cache.hits.resize(w * h, None);
+        }
+        let counts = image
+            .pixels
+            .par_chunks_mut(w)
+            .zip(cache.hits.par_chunks_mut(w))
+            .enumerate()
+            .map(|(y, (row, hits))| {
+                let mut n = RayCounts::default();
+                for (x, (px, hit)) in row.iter_mut().zip(hits.iter_mut()).enumerate() {
+                    let ray = rays.ray(x as f32 + 0.5, y as f32 + 0.5);
+                    if !reuse {
+                        n.primary += 1;
+                        *hit = scene.intersect(&ray, f32::INFINITY);
+                    }
+                    let mut rng = Rng::for_sample((y * w + x) as u64, 0, settings.frame);
+                    *px = tracer.shade_primary(&ray, *hit, &mut rng, &mut n);
+                }
+                n
+            })
+            .reduce(RayCounts::default, sum);
+        cache.key = key;
+        counts
+    } else {
+        let strata = (samples as f32).sqrt() as u32;
+        let square = strata * strata == samples;
+        image
+            .pixels
+            .par_chunks_mut(w)
+            .enumerate()
+            .map(|(y, row)| {
+                let mut n = RayCounts::default();
+                for (x, px) in row.iter_mut().enumerate() {
+                    let mut acc = Vec3::ZERO;
+                    for s in 0..samples {
+                        let mut rng = Rng::for_sample((y * w + x) as u64, s, settings.frame);
+                        let (jx, jy) = (rng.next_f32(), rng.next_f32());
+                        // Stratified: an s×s grid when samples is square, else strata in x.
+                        let (ox, oy) = if square {
+                            (
+                                ((s % strata) as f32 + jx) / strata as f32,
+                                ((s / strata) as f32 + jy) / strata as f32,
+                            )
+                        } else {
+                            ((s as f32 + jx) / samples as f32, jy)
+                        };
+                        let ray = rays.ray(x as f32 + ox, y as f32 + oy);
+                        n.primary += 1;
+                        let hit = scene.intersect(&ray, f32::INFINITY);
+                        acc += tracer.shade_primary(&ray, hit, &mut rng, &mut n);
+                    }
+                    *px = acc / samples as f32;
+                }
+                n
+            })
+            .reduce(RayCounts::default, sum)
+    };
+    Frame {
+        image,
+        stats: FrameStats {
+            rays: counts,
+            samples,
+            elapsed: start.elapsed(),
+        },
+    }
+}
+
+fn sum(mut a: RayCounts, b: RayCounts) -> RayCounts {
+    a += b;
+    a
+}

@@ -1,0 +1,262 @@
+//! A scene: triangles with materials, point lights, a starting camera and the effects it calls
+//! for. A scene that was built is valid: every triangle has a finite unit normal, every light a
+//! finite position and non-negative power, so rendering it cannot fail.
+
+use std::ops::Range;
+
+use glam::Vec3;
+
+use crate::accel::{Accel, Hit};
+use crate::camera::Camera;
+use crate::geometry::{Aabb, DegenerateTriangle, Ray, Triangle};
+
+/// A surface's material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Diffuse reflectance ρ, linear RGB.
+    pub colour: Vec3,
+    /// Mirror reflectance in `[0, 1]`: the fraction of light reflected specularly. 0 is a
+    /// purely diffuse surface, for which no reflection ray is ever traced.
+    pub mirror: f32,
+}
+
+impl Material {
+    /// A purely diffuse material.
+    pub const fn diffuse(colour: Vec3) -> Material {
+        Material {
+            colour,
+            mirror: 0.0,
+        }
+    }
+}
+
+/// A point light radiating `power` (per channel) equally in all directions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLight {
+    /// Where the light is.
+    pub position: Vec3,
+    /// Radiant power per channel, the seed's P (14 for the Cornell box).
+    pub power: Vec3,
+}
+
+/// How indirect light is computed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Indirect {
+    /// No indirect light: shadows are black.
+    None,
+    /// The seed's constant term N, added to the direct irradiance before multiplying by ρ.
+    Constant(f32),
+    /// Path-traced diffuse interreflection with next-event estimation.
+    PathTraced {
+        /// Maximum number of diffuse bounces after the primary hit.
+        bounces: u32,
+    },
+}
+
+/// What a frame computes. The scene says what it calls for; settings may change it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Effects {
+    /// Trace shadow rays towards each light.
+    pub shadows: bool,
+    /// The indirect-light model.
+    pub indirect: Indirect,
+    /// Samples per pixel (stratified within the pixel; 1 = one ray through the centre).
+    pub samples: u32,
+}
+
+impl Effects {
+    /// The seed's set: shadows, constant N = 0.5, one sample per pixel.
+    pub const SEED: Effects = Effects {
+        shadows: true,
+        indirect: Indirect::Constant(0.5),
+        samples: 1,
+    };
+}
+
+impl Default for Effects {
+    fn default() -> Effects {
+        Effects::SEED
+    }
+}
+
+/// A renderable scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// A short name for display (e.g. "cornell").
+    pub name: String,
+    /// All triangles; [`Hit::triangle`] indexes this.
+    pub triangles: Vec<Triangle>,
+    /// Materials; [`Triangle::material`] indexes this.
+    pub materials: Vec<Material>,
+    /// The lights the scene starts with.
+    pub lights: Vec<PointLight>,
+    /// The camera the scene starts with.
+    pub camera: Camera,
+    /// The effects the scene calls for.
+    pub effects: Effects,
+    /// Length of the bounding box's diagonal: the scene's scale.
+    pub extent: f32,
+    accel: Accel,
+    has_mirrors: bool,
+}
+
+/// Why a scene could not be built.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SceneError {
+    /// A triangle is degenerate.
+    Triangle {
+        /// Index of the triangle in the order added.
+        index: usize,
+        /// What is wrong with it.
+        problem: DegenerateTriangle,
+    },
+    /// A triangle names a material that does not exist.
+    Material {
+        /// Index of the triangle.
+        index: usize,
+    },
+    /// A light has a non-finite position or a negative or non-finite power.
+    Light {
+        /// Index of the light.
+        index: usize,
+    },
+}
+
+impl std::fmt::Display for SceneError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SceneError::Triangle { index, problem } => write!(f, "triangle {index}: {problem}"),
+            SceneError::Material { index } => write!(f, "triangle {index}: unknown material"),
+            SceneError::Light { index } => write!(
+                f,
+                "light {index}: position must be finite and power finite and non-negative"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+/// Collects objects (groups of triangles) and builds a [`Scene`].
+#[derive(Clone, Debug, Default)]
+pub struct SceneBuilder {
+    triangles: Vec<Triangle>,
+    objects: Vec<Range<usize>>,
+    materials: Vec<Material>,
+    lights: Vec<PointLight>,
+    error: Option<SceneError>,
+    added: usize,
+}
+
+impl SceneBuilder {
+    /// An empty builder.
+    pub fn new() -> SceneBuilder {
+        SceneBuilder::default()
+    }
+
+    /// Adds a material and returns its index.
+    pub fn material(&mut self, m: Material) -> u32 {
+        self.materials.push(m);
+        (self.materials.len() - 1) as u32
+    }
+
+    /// Adds an object: triangles given as vertex triples, all of one material. Degenerate
+    /// triangles are an error (the first one is reported by [`SceneBuilder::build`]).
+    pub fn object(&mut self, triangles: impl IntoIterator<Item = [Vec3; 3]>, material: u32) {
+        let start = self.triangles.len();
+        for [a, b, c] in triangles {
+            match Triangle::new(a, b, c, material) {
+                Ok(t) => self.triangles.push(t),
+                Err(problem) => {
+                    self.error.get_or_insert(SceneError::Triangle {
+                        index: self.added,
+                        problem,
+                    });
+                }
+            }
+            self.added += 1;
+        }
+        self.objects.push(start..self.triangles.len());
+    }
+
+    /// Adds a light.
+    pub fn light(&mut self, l: PointLight) {
+        self.lights.push(l);
+    }
+
+    /// Validates and builds the scene.
+    pub fn build(self, name: &str, camera: Camera, effects: Effects) -> Result<Scene, SceneError> {
+        if let Some(e) = self.error {
+            return Err(e);
+        }
+        if let Some(index) = self
+            .triangles
+            .iter()
+            .position(|t| t.material as usize >= self.materials.len())
+        {
+            return Err(SceneError::Material { index });
+        }
+        if let Some(index) = self.lights.iter().position(|l| {
+            !l.position.is_finite() || !l.power.is_finite() || l.power.min_element() < 0.0
+        }) {
+            return Err(SceneError::Light { index });
+        }
+        let bounds = self
+            .triangles
+            .iter()
+            .fold(Aabb::EMPTY, |b, t| b.union(Aabb::of_triangle(t)));
+        let extent = if self.triangles.is_empty() {
+            1.0
+        } else {
+            (bounds.max - bounds.min).length()
+        };
+        let accel = Accel::build(&self.triangles, &self.objects);
+        let has_mirrors = self.materials.iter().any(|m| m.mirror > 0.0);
+        Ok(Scene {
+            name: name.to_string(),
+            triangles: self.triangles,
+            materials: self.materials,
+            lights: self.lights,
+            camera,
+            effects,
+            extent: if extent.is_finite() && extent > 0.0 {
+                extent
+            } else {
+                1.0
+            },
+            accel,
+            has_mirrors,
+        })
+    }
+}
+
+impl Scene {
+    /// The closest hit along `ray` with `t < t_max`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        self.accel.intersect(&self.triangles, ray, t_max)
+    }
+
+    /// Whether anything blocks `ray` before `t_max`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        self.accel.occluded(&self.triangles, ray, t_max)
+    }
+
+    /// Whether any material reflects specularly (if not, no reflection ray is ever traced).
+    pub fn has_mirrors(&self) -> bool {
+        self.has_mirrors
+    }
+
+    /// The closest distance at which a point light is evaluated, relative to the scene's scale:
+    /// `r²` in the inverse-square law is clamped to at least this squared, so a light on a
+    /// surface gives a large but finite irradiance (see [`crate::shading`]).
+    pub fn min_light_distance(&self) -> f32 {
+        self.extent * MIN_LIGHT_DISTANCE_FRACTION
+    }
+}
+
+/// The point light is treated as a sphere of this radius, as a fraction of the scene's
+/// diagonal: 1e-3 of a 3.5-unit Cornell box is 3.5 mm of a 55 cm room, small enough to change
+/// no pixel of the seed's views, large enough that `1/r²` stays far from overflow.
+pub const MIN_LIGHT_DISTANCE_FRACTION: f32 = 1e-3;

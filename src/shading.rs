@@ -1,0 +1,294 @@
+//! Shading: what colour a ray brings back. The seed's stages, direct light with shadow rays,
+//! the constant indirect term, mirrors, and path-traced indirect light, all in the seed's units
+//! (a pixel is ρ·E, with E the irradiance; the diffuse BRDF's 1/π is dropped, as the seed does).
+
+use std::f32::consts::PI;
+
+use glam::Vec3;
+
+use crate::accel::Hit;
+use crate::geometry::{Ray, hit_point, offset_ray_origin};
+use crate::rng::Rng;
+use crate::scene::{Effects, Indirect, PointLight, Scene};
+
+/// The seed's stages, selectable by name and by the keys 1-6.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Stage {
+    /// The triangle's colour (the seed's Fig. 2).
+    Flat,
+    /// Direct irradiance D as grey, no shadows (Figs. 7-9).
+    Light,
+    /// ρ·D, no shadows (Figs. 10-12).
+    Direct,
+    /// ρ·D with shadow rays (Fig. 13).
+    Shadows,
+    /// ρ·(D + N): the effects the scene calls for (Fig. 14 for the Cornell box; the default).
+    Indirect,
+    /// Path-traced global illumination.
+    Gi,
+}
+
+impl Stage {
+    /// All stages in key order (1-6).
+    pub const ALL: [Stage; 6] = [
+        Stage::Flat,
+        Stage::Light,
+        Stage::Direct,
+        Stage::Shadows,
+        Stage::Indirect,
+        Stage::Gi,
+    ];
+
+    /// The stage's name as the CLI takes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Flat => "flat",
+            Stage::Light => "light",
+            Stage::Direct => "direct",
+            Stage::Shadows => "shadows",
+            Stage::Indirect => "indirect",
+            Stage::Gi => "gi",
+        }
+    }
+
+    /// Parses a stage name.
+    pub fn from_name(name: &str) -> Option<Stage> {
+        Stage::ALL.into_iter().find(|s| s.name() == name)
+    }
+
+    /// What this stage computes, given the effects the scene calls for.
+    pub fn settings(self, scene: Effects) -> Settings {
+        let none = Effects {
+            shadows: false,
+            indirect: Indirect::None,
+            samples: 1,
+        };
+        let (mode, effects) = match self {
+            Stage::Flat => (Mode::Flat, none),
+            Stage::Light => (Mode::Irradiance, none),
+            Stage::Direct => (Mode::Colour, none),
+            Stage::Shadows => (
+                Mode::Colour,
+                Effects {
+                    shadows: true,
+                    ..none
+                },
+            ),
+            Stage::Indirect => (Mode::Colour, scene),
+            Stage::Gi => (
+                Mode::Colour,
+                Effects {
+                    shadows: true,
+                    indirect: Indirect::PathTraced { bounces: 4 },
+                    samples: 1,
+                },
+            ),
+        };
+        Settings {
+            mode,
+            effects,
+            frame: 0,
+        }
+    }
+}
+
+/// What a hit's colour is made of.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// The material colour ρ.
+    Flat,
+    /// The direct irradiance D itself.
+    Irradiance,
+    /// ρ·(direct + indirect), with mirrors.
+    Colour,
+}
+
+/// Everything that decides a frame's pixels besides the scene, camera, lights and size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// What a hit's colour is made of.
+    pub mode: Mode,
+    /// Which effects run.
+    pub effects: Effects,
+    /// Frame number: seeds the random numbers (progressive refinement uses a new one per pass).
+    pub frame: u32,
+}
+
+/// Rays traced, by kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounts {
+    /// Camera rays.
+    pub primary: u64,
+    /// Rays towards a light (any-hit queries).
+    pub shadow: u64,
+    /// Diffuse bounce rays of path-traced indirect light.
+    pub bounce: u64,
+    /// Mirror reflection rays.
+    pub reflection: u64,
+}
+
+impl RayCounts {
+    /// All rays.
+    pub fn total(&self) -> u64 {
+        self.primary + self.shadow + self.bounce + self.reflection
+    }
+}
+
+impl std::ops::AddAssign for RayCounts {
+    fn add_assign(&mut self, o: RayCounts) {
+        self.primary += o.primary;
+        self.shadow += o.shadow;
+        self.bounce += o.bounce;
+        self.reflection += o.reflection;
+    }
+}
+
+/// A shadow ray stops this fraction of its length short of the light, so that a light lying
+/// exactly on a surface is not shadowed by that surface's own rounding. Relative, so it holds at
+/// every scale.
+pub const SHADOW_EPSILON: f32 = 1e-4;
+
+/// Mirror reflection stops after this many reflections (two facing mirrors would never end).
+pub const MAX_MIRROR_DEPTH: u32 = 8;
+
+/// Shades rays for one frame.
+pub struct Tracer<'a> {
+    scene: &'a Scene,
+    lights: &'a [PointLight],
+    settings: Settings,
+    min_r2: f32,
+}
+
+impl<'a> Tracer<'a> {
+    /// A tracer of `scene` lit by `lights` (which may differ from the scene's own).
+    pub fn new(scene: &'a Scene, lights: &'a [PointLight], settings: Settings) -> Tracer<'a> {
+        let r = scene.min_light_distance();
+        Tracer {
+            scene,
+            lights,
+            settings,
+            min_r2: r * r,
+        }
+    }
+
+    /// The colour seen along a primary ray, given its closest hit.
+    pub fn shade_primary(
+        &self,
+        ray: &Ray,
+        hit: Option<Hit>,
+        rng: &mut Rng,
+        n: &mut RayCounts,
+    ) -> Vec3 {
+        let Some(hit) = hit else { return Vec3::ZERO };
+        let c = self.shade(ray, &hit, 0, 0, rng, n);
+        debug_assert!(c.is_finite(), "non-finite colour {c}");
+        c
+    }
+
+    /// The colour seen along `ray` (any depth).
+    fn trace(
+        &self,
+        ray: &Ray,
+        mirror_depth: u32,
+        bounce: u32,
+        rng: &mut Rng,
+        n: &mut RayCounts,
+    ) -> Vec3 {
+        match self.scene.intersect(ray, f32::INFINITY) {
+            Some(hit) => self.shade(ray, &hit, mirror_depth, bounce, rng, n),
+            None => Vec3::ZERO,
+        }
+    }
+
+    fn shade(
+        &self,
+        ray: &Ray,
+        hit: &Hit,
+        mirror_depth: u32,
+        bounce: u32,
+        rng: &mut Rng,
+        n: &mut RayCounts,
+    ) -> Vec3 {
+        let tri = &self.scene.triangles[hit.triangle as usize];
+        let material = &self.scene.materials[tri.material as usize];
+        if self.settings.mode == Mode::Flat {
+            return material.colour;
+        }
+        let (p, err) = hit_point(&tri.v, hit.b);
+        // Two-sided shading: light the side the ray came from.
+        let normal = if tri.normal.dot(ray.dir) > 0.0 {
+            -tri.normal
+        } else {
+            tri.normal
+        };
+        let direct = self.direct(p, err, normal, n);
+        if self.settings.mode == Mode::Irradiance {
+            return direct;
+        }
+        let indirect = match self.settings.effects.indirect {
+            Indirect::None => Vec3::ZERO,
+            Indirect::Constant(k) => Vec3::splat(k),
+            Indirect::PathTraced { bounces } if bounce < bounces => {
+                let dir = cosine_sample(normal, rng);
+                let origin = offset_ray_origin(p, err, normal, dir);
+                n.bounce += 1;
+                self.trace(&Ray::new(origin, dir), mirror_depth, bounce + 1, rng, n)
+            }
+            Indirect::PathTraced { .. } => Vec3::ZERO,
+        };
+        let diffuse = material.colour * (direct + indirect);
+        if material.mirror > 0.0 && mirror_depth < MAX_MIRROR_DEPTH {
+            let d = ray.dir.normalize();
+            let dir = d - 2.0 * d.dot(normal) * normal;
+            let origin = offset_ray_origin(p, err, normal, dir);
+            n.reflection += 1;
+            let reflected = self.trace(&Ray::new(origin, dir), mirror_depth + 1, bounce, rng, n);
+            diffuse * (1.0 - material.mirror) + reflected * material.mirror
+        } else {
+            diffuse
+        }
+    }
+
+    /// Direct irradiance at `p` (error bound `err`) on a surface with normal `normal`, summed
+    /// over the lights: `D = P·max(r̂·n̂, 0)/(4πr²)`, with `r²` clamped to the scene's minimum
+    /// light distance. A light behind the surface contributes nothing and costs no shadow ray.
+    pub fn direct(&self, p: glam::Vec3, err: Vec3, normal: Vec3, n: &mut RayCounts) -> Vec3 {
+        let mut sum = Vec3::ZERO;
+        for light in self.lights {
+            let to_light = light.position - p;
+            let dist2 = to_light.length_squared();
+            if !(dist2 > 0.0) {
+                continue;
+            }
+            let cos = normal.dot(to_light) / dist2.sqrt();
+            if !(cos > 0.0) {
+                continue;
+            }
+            if self.settings.effects.shadows {
+                let origin = offset_ray_origin(p, err, normal, to_light);
+                let dir = light.position - origin;
+                if dir != Vec3::ZERO && dir.is_finite() {
+                    n.shadow += 1;
+                    if self
+                        .scene
+                        .occluded(&Ray::new(origin, dir), 1.0 - SHADOW_EPSILON)
+                    {
+                        continue;
+                    }
+                }
+            }
+            sum += light.power * cos / (4.0 * PI * dist2.max(self.min_r2));
+        }
+        sum
+    }
+}
+
+/// A cosine-weighted direction on the hemisphere around `n` (unit length).
+fn cosine_sample(n: Vec3, rng: &mut Rng) -> Vec3 {
+    let (u1, u2) = (rng.next_f32(), rng.next_f32());
+    let r = u1.sqrt();
+    let phi = 2.0 * PI * u2;
+    let (s, c) = phi.sin_cos();
+    let (t, b) = n.any_orthonormal_pair();
+    (t * (r * c) + b * (r * s) + n * (1.0 - u1).max(0.0).sqrt()).normalize()
+}
