@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
 use raytty::{CellGrid, ColorMode, PointLight, Scene, Stage, cornell_box, encode_text, render};
 
@@ -22,6 +22,39 @@ use raytty::{CellGrid, ColorMode, PointLight, Scene, Stage, cornell_box, encode_
 pub struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// Colours of the app and of the frame printed with no command: auto (ascii if NO_COLOR is
+    /// set, truecolor if COLORTERM is truecolor or 24bit, else 256), truecolor, 256 or ascii.
+    /// ssh does not forward COLORTERM: pass --color truecolor (or press C) to get it back.
+    #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+    color: ColorChoice,
+}
+
+/// The `--color` choices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum ColorChoice {
+    /// Decide from NO_COLOR and COLORTERM.
+    Auto,
+    /// 24-bit colour.
+    Truecolor,
+    /// The xterm 256-colour palette.
+    #[value(name = "256")]
+    Ansi256,
+    /// No colour escapes at all.
+    Ascii,
+}
+
+/// The colour mode for `choice`, given whether NO_COLOR is set (and not empty) and COLORTERM.
+fn resolve_color(choice: ColorChoice, no_color: bool, colorterm: Option<&str>) -> ColorMode {
+    match choice {
+        ColorChoice::Truecolor => ColorMode::TrueColor,
+        ColorChoice::Ansi256 => ColorMode::Ansi256,
+        ColorChoice::Ascii => ColorMode::Ascii,
+        ColorChoice::Auto if no_color => ColorMode::Ascii,
+        ColorChoice::Auto if matches!(colorterm, Some("truecolor" | "24bit")) => {
+            ColorMode::TrueColor
+        }
+        ColorChoice::Auto => ColorMode::Ansi256,
+    }
 }
 
 #[derive(Subcommand, Debug)]
@@ -129,13 +162,24 @@ fn parse_camera(s: &str) -> Result<[f32; 4], String> {
 
 /// Parses the command line, runs it, and maps the outcome to an exit code.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    #[allow(unused_mut)]
+    let mut cmd = Cli::command();
+    #[cfg(feature = "tui")]
+    {
+        cmd = cmd.after_long_help(crate::tui::keys::help_text());
+    }
+    let cli = Cli::from_arg_matches(&cmd.get_matches()).unwrap_or_else(|e| e.exit());
+    let color = resolve_color(
+        cli.color,
+        std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty()),
+        std::env::var("COLORTERM").ok().as_deref(),
+    );
     let result = match cli.command {
-        Some(Command::Render(args)) => run_render(&args),
-        None => run_default(),
+        Some(Command::Render(args)) => run_render(&args).map(|()| ExitCode::SUCCESS),
+        None => run_default(color),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("raytty: {e:#}");
@@ -167,21 +211,27 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
     })
 }
 
-/// No command: one frame to stdout, as `raytty render` with its defaults.
-fn run_default() -> Result<()> {
+/// No command: the app on a terminal; otherwise one frame to stdout, as `raytty render` with
+/// its defaults would print in `color`.
+fn run_default(color: ColorMode) -> Result<ExitCode> {
+    #[cfg(feature = "tui")]
+    if io::stdout().is_terminal() {
+        return crate::tui::run(cornell_box(), color);
+    }
     run_render(&RenderArgs {
         size: (80, 24),
         pixels: None,
-        format: if std::env::var_os("NO_COLOR").is_some() {
-            Format::Ascii
-        } else {
-            Format::Ansi
+        format: match color {
+            ColorMode::TrueColor => Format::Ansi,
+            ColorMode::Ansi256 => Format::Ansi256,
+            ColorMode::Ascii => Format::Ascii,
         },
         stage: Stage::Indirect,
         camera: None,
         light: None,
         output: None,
-    })
+    })?;
+    Ok(ExitCode::SUCCESS)
 }
 
 fn run_render(args: &RenderArgs) -> Result<()> {
@@ -245,4 +295,32 @@ fn lights_with(scene: &Scene, light: Option<Vec3>) -> Vec<PointLight> {
         first.position = p;
     }
     lights
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn auto_colour_follows_no_color_then_colorterm() {
+        let auto = ColorChoice::Auto;
+        assert_eq!(
+            resolve_color(auto, true, Some("truecolor")),
+            ColorMode::Ascii
+        );
+        assert_eq!(
+            resolve_color(auto, false, Some("truecolor")),
+            ColorMode::TrueColor
+        );
+        assert_eq!(
+            resolve_color(auto, false, Some("24bit")),
+            ColorMode::TrueColor
+        );
+        assert_eq!(resolve_color(auto, false, Some("yes")), ColorMode::Ansi256);
+        assert_eq!(resolve_color(auto, false, None), ColorMode::Ansi256);
+        assert_eq!(
+            resolve_color(ColorChoice::Truecolor, true, None),
+            ColorMode::TrueColor
+        );
+    }
 }

@@ -1,0 +1,217 @@
+//! The app's model and `update`: what the user sees is a function of [`App`], and every change
+//! to it is a [`Message`]. No terminal here, so all of it is testable as plain data.
+
+use glam::Vec3;
+use raytty::{Camera, ColorMode, PointLight, Scene, Stage};
+
+/// Everything that can happen to the app.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Message {
+    /// Move the camera along its forward axis by this many scene units (negative: back).
+    Walk(f32),
+    /// Turn the camera by this many radians (positive: to the right).
+    Turn(f32),
+    /// Move the light by this offset in camera axes (right, down, forward), scene units.
+    MoveLight(Vec3),
+    /// Switch to a stage.
+    SetStage(Stage),
+    /// Put the camera and the light back where the scene starts them.
+    Reset,
+    /// Next colour mode (truecolor → 256 → ascii).
+    CycleColor,
+    /// Show or hide the key help.
+    ToggleHelp,
+    /// The terminal now has this many columns and rows.
+    Resize {
+        /// Columns.
+        cols: u16,
+        /// Rows.
+        rows: u16,
+    },
+    /// Leave the app.
+    Quit,
+}
+
+/// The app's state.
+#[derive(Clone, Debug)]
+pub struct App {
+    /// The scene shown (any scene: the built-in box or one loaded from a file).
+    pub scene: Scene,
+    /// Where the camera is.
+    pub camera: Camera,
+    /// The lights; keys move the first one.
+    pub lights: Vec<PointLight>,
+    /// The shading stage.
+    pub stage: Stage,
+    /// How cells are coloured.
+    pub color: ColorMode,
+    /// Whether the key help covers the frame.
+    pub help: bool,
+    /// Terminal size in cells (columns, rows).
+    pub size: (u16, u16),
+    /// Set by [`Message::Quit`].
+    pub quit: bool,
+    /// Bumped whenever the image's inputs change (camera, lights, stage, size): a progressive
+    /// render restarts when it changes.
+    pub generation: u64,
+    /// Something visible changed since the last draw.
+    pub dirty: bool,
+}
+
+impl App {
+    /// The app at the scene's starting view, in the default stage.
+    pub fn new(scene: Scene, color: ColorMode, size: (u16, u16)) -> App {
+        App {
+            camera: scene.camera,
+            lights: scene.lights.clone(),
+            scene,
+            stage: Stage::Indirect,
+            color,
+            help: false,
+            size,
+            quit: false,
+            generation: 0,
+            dirty: true,
+        }
+    }
+
+    /// The position of the light the keys move, if the scene has one.
+    pub fn light(&self) -> Option<Vec3> {
+        self.lights.first().map(|l| l.position)
+    }
+}
+
+/// Applies one message.
+pub fn update(app: &mut App, msg: Message) {
+    let image_changes = match msg {
+        Message::Walk(d) => {
+            app.camera.position += app.camera.forward() * d;
+            d != 0.0
+        }
+        Message::Turn(a) => {
+            // Keep yaw in (−π, π] so the status line stays readable after many turns.
+            let yaw = (app.camera.yaw + a + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU)
+                - std::f32::consts::PI;
+            let changed = yaw != app.camera.yaw;
+            app.camera.yaw = yaw;
+            changed
+        }
+        Message::MoveLight(local) => {
+            let world = app.camera.to_world(local);
+            match app.lights.first_mut() {
+                Some(l) => {
+                    l.position += world;
+                    true
+                }
+                None => false,
+            }
+        }
+        Message::SetStage(s) => {
+            let changed = s != app.stage;
+            app.stage = s;
+            changed
+        }
+        Message::Reset => {
+            app.camera = app.scene.camera;
+            app.lights = app.scene.lights.clone();
+            true
+        }
+        Message::CycleColor => {
+            app.color = app.color.next();
+            app.dirty = true;
+            false
+        }
+        Message::ToggleHelp => {
+            app.help = !app.help;
+            app.dirty = true;
+            false
+        }
+        Message::Resize { cols, rows } => {
+            let changed = (cols, rows) != app.size;
+            app.size = (cols, rows);
+            changed
+        }
+        Message::Quit => {
+            app.quit = true;
+            false
+        }
+    };
+    if image_changes {
+        app.generation += 1;
+        app.dirty = true;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use raytty::cornell_box;
+
+    /// Moves are sums of a few f32 steps: this is far above their rounding, far below a step.
+    const TOLERANCE: f32 = 1e-5;
+
+    fn app() -> App {
+        App::new(cornell_box(), ColorMode::TrueColor, (80, 24))
+    }
+
+    #[test]
+    fn walking_moves_along_the_view_and_turning_changes_the_view() {
+        let mut a = app();
+        let start = a.camera.position;
+        update(&mut a, Message::Walk(0.1));
+        assert!((a.camera.position - start - Vec3::new(0.0, 0.0, 0.1)).length() < TOLERANCE);
+        update(&mut a, Message::Turn(std::f32::consts::FRAC_PI_2));
+        update(&mut a, Message::Walk(0.1));
+        assert!((a.camera.position - start - Vec3::new(0.1, 0.0, 0.1)).length() < TOLERANCE);
+        assert_eq!(a.generation, 3);
+    }
+
+    #[test]
+    fn light_moves_along_the_camera_axes_and_reset_restores_it() {
+        let mut a = app();
+        let start = a.light().unwrap();
+        update(&mut a, Message::Turn(std::f32::consts::FRAC_PI_2));
+        // Forward is +x after a quarter turn right.
+        update(&mut a, Message::MoveLight(Vec3::new(0.0, 0.0, 0.1)));
+        assert!((a.light().unwrap() - start - Vec3::new(0.1, 0.0, 0.0)).length() < TOLERANCE);
+        update(&mut a, Message::Reset);
+        assert_eq!(a.light(), Some(start));
+        assert_eq!(a.camera, a.scene.camera);
+    }
+
+    #[test]
+    fn yaw_stays_in_one_turn_after_many_turns() {
+        let mut a = app();
+        for _ in 0..1000 {
+            update(&mut a, Message::Turn(5f32.to_radians()));
+        }
+        assert!(a.camera.yaw.abs() <= std::f32::consts::PI + TOLERANCE);
+    }
+
+    #[test]
+    fn only_image_changes_restart_the_render() {
+        let mut a = app();
+        a.dirty = false;
+        update(&mut a, Message::CycleColor);
+        update(&mut a, Message::ToggleHelp);
+        assert_eq!(
+            (a.generation, a.dirty, a.color, a.help),
+            (0, true, ColorMode::Ansi256, true)
+        );
+        update(&mut a, Message::SetStage(Stage::Indirect));
+        update(&mut a, Message::Resize { cols: 80, rows: 24 });
+        assert_eq!(a.generation, 0, "nothing changed");
+        update(&mut a, Message::SetStage(Stage::Gi));
+        update(
+            &mut a,
+            Message::Resize {
+                cols: 100,
+                rows: 30,
+            },
+        );
+        assert_eq!((a.generation, a.size), (2, (100, 30)));
+        assert!(!a.quit);
+        update(&mut a, Message::Quit);
+        assert!(a.quit);
+    }
+}

@@ -1,0 +1,225 @@
+//! Terminal input bytes to key events, for the legacy encoding every terminal speaks (xterm,
+//! tmux, screen, the Linux console, over SSH). We read the tty ourselves rather than through
+//! crossterm's reader because that reader spins when the tty reports end-of-file or EIO (a
+//! dropped SSH connection); this parser is pure, so the reader thread can stop on EOF.
+
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+
+/// Longest escape sequence kept across reads; anything longer is dropped as garbage.
+const MAX_PENDING: usize = 32;
+
+/// Parses a byte stream into key events, keeping an incomplete sequence for the next read.
+#[derive(Debug, Default)]
+pub struct KeyParser {
+    pending: Vec<u8>,
+}
+
+impl KeyParser {
+    /// The key events in `bytes` (after what an earlier call left incomplete). A lone ESC at
+    /// the end of a read is the Esc key, as terminals send escape sequences in one write.
+    pub fn feed(&mut self, bytes: &[u8]) -> Vec<KeyEvent> {
+        let mut buf = std::mem::take(&mut self.pending);
+        buf.extend_from_slice(bytes);
+        let mut keys = Vec::new();
+        let mut i = 0;
+        while i < buf.len() {
+            match parse_one(&buf[i..]) {
+                Parsed::Key(used, key) => {
+                    keys.extend(key);
+                    i += used;
+                }
+                Parsed::Incomplete => {
+                    if buf.len() - i <= MAX_PENDING {
+                        self.pending = buf[i..].to_vec();
+                    }
+                    break;
+                }
+            }
+        }
+        keys
+    }
+}
+
+enum Parsed {
+    /// Bytes used and the key they make, if any.
+    Key(usize, Option<KeyEvent>),
+    /// The buffer ends inside a sequence.
+    Incomplete,
+}
+
+fn key(code: KeyCode, modifiers: KeyModifiers) -> Option<KeyEvent> {
+    Some(KeyEvent::new(code, modifiers))
+}
+
+fn parse_one(b: &[u8]) -> Parsed {
+    let none = KeyModifiers::NONE;
+    match b[0] {
+        0x1b => match b.get(1) {
+            None | Some(0x1b) => Parsed::Key(1, key(KeyCode::Esc, none)),
+            Some(b'[') => parse_csi(b),
+            Some(b'O') => match b.get(2) {
+                None => Parsed::Incomplete,
+                Some(&f) => Parsed::Key(3, arrow(f).map(|c| KeyEvent::new(c, none))),
+            },
+            // ESC then a key: Alt+key.
+            Some(_) => match parse_one(&b[1..]) {
+                Parsed::Key(n, k) => Parsed::Key(
+                    n + 1,
+                    k.map(|mut k| {
+                        k.modifiers |= KeyModifiers::ALT;
+                        k
+                    }),
+                ),
+                Parsed::Incomplete => Parsed::Incomplete,
+            },
+        },
+        b'\r' | b'\n' => Parsed::Key(1, key(KeyCode::Enter, none)),
+        b'\t' => Parsed::Key(1, key(KeyCode::Tab, none)),
+        0x7f | 0x08 => Parsed::Key(1, key(KeyCode::Backspace, none)),
+        c @ 0x01..=0x1a => Parsed::Key(
+            1,
+            key(KeyCode::Char((c - 1 + b'a') as char), KeyModifiers::CONTROL),
+        ),
+        c @ 0x20..=0x7e => {
+            let shift = if c.is_ascii_uppercase() {
+                KeyModifiers::SHIFT
+            } else {
+                none
+            };
+            Parsed::Key(1, key(KeyCode::Char(c as char), shift))
+        }
+        c if c >= 0xc0 => {
+            let len = match c {
+                0xc0..=0xdf => 2,
+                0xe0..=0xef => 3,
+                _ => 4,
+            };
+            if b.len() < len {
+                return Parsed::Incomplete;
+            }
+            match std::str::from_utf8(&b[..len])
+                .ok()
+                .and_then(|s| s.chars().next())
+            {
+                Some(ch) => Parsed::Key(len, key(KeyCode::Char(ch), none)),
+                None => Parsed::Key(1, None),
+            }
+        }
+        _ => Parsed::Key(1, None),
+    }
+}
+
+/// CSI: ESC [ parameters intermediates final.
+fn parse_csi(b: &[u8]) -> Parsed {
+    let mut j = 2;
+    while j < b.len() && (0x20..=0x3f).contains(&b[j]) {
+        j += 1;
+    }
+    let Some(&f) = b.get(j) else {
+        return Parsed::Incomplete;
+    };
+    let params = std::str::from_utf8(&b[2..j]).unwrap_or("");
+    // xterm's modifier parameter "1;m": m − 1 is a bit set of Shift 1, Alt 2, Ctrl 4.
+    let m: u8 = params
+        .split(';')
+        .nth(1)
+        .and_then(|m| m.parse().ok())
+        .unwrap_or(1);
+    let bits = m.saturating_sub(1);
+    let mut mods = KeyModifiers::NONE;
+    for (bit, flag) in [
+        (1, KeyModifiers::SHIFT),
+        (2, KeyModifiers::ALT),
+        (4, KeyModifiers::CONTROL),
+    ] {
+        if bits & bit != 0 {
+            mods |= flag;
+        }
+    }
+    Parsed::Key(j + 1, arrow(f).map(|c| KeyEvent::new(c, mods)))
+}
+
+fn arrow(f: u8) -> Option<KeyCode> {
+    match f {
+        b'A' => Some(KeyCode::Up),
+        b'B' => Some(KeyCode::Down),
+        b'C' => Some(KeyCode::Right),
+        b'D' => Some(KeyCode::Left),
+        b'H' => Some(KeyCode::Home),
+        b'F' => Some(KeyCode::End),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn codes(p: &mut KeyParser, bytes: &[u8]) -> Vec<(KeyCode, KeyModifiers)> {
+        p.feed(bytes)
+            .into_iter()
+            .map(|k| (k.code, k.modifiers))
+            .collect()
+    }
+
+    #[test]
+    fn arrows_in_normal_and_application_mode_with_modifiers() {
+        let mut p = KeyParser::default();
+        let n = KeyModifiers::NONE;
+        assert_eq!(
+            codes(&mut p, b"\x1b[A\x1bOD\x1b[1;2C\x1b[1;5B"),
+            vec![
+                (KeyCode::Up, n),
+                (KeyCode::Left, n),
+                (KeyCode::Right, KeyModifiers::SHIFT),
+                (KeyCode::Down, KeyModifiers::CONTROL),
+            ]
+        );
+    }
+
+    #[test]
+    fn lone_escape_is_esc_and_split_sequences_wait() {
+        let mut p = KeyParser::default();
+        assert_eq!(
+            codes(&mut p, b"\x1b"),
+            vec![(KeyCode::Esc, KeyModifiers::NONE)]
+        );
+        assert_eq!(
+            codes(&mut p, b"w\x1b[1;"),
+            vec![(KeyCode::Char('w'), KeyModifiers::NONE)]
+        );
+        assert_eq!(
+            codes(&mut p, b"2A"),
+            vec![(KeyCode::Up, KeyModifiers::SHIFT)]
+        );
+    }
+
+    #[test]
+    fn letters_control_keys_utf8_and_unknown_sequences() {
+        let mut p = KeyParser::default();
+        assert_eq!(
+            codes(&mut p, "Q\x03é\x1b[15~?".as_bytes()),
+            vec![
+                (KeyCode::Char('Q'), KeyModifiers::SHIFT),
+                (KeyCode::Char('c'), KeyModifiers::CONTROL),
+                (KeyCode::Char('é'), KeyModifiers::NONE),
+                (KeyCode::Char('?'), KeyModifiers::NONE),
+            ]
+        );
+    }
+
+    #[test]
+    fn random_bytes_never_panic_and_never_grow_the_buffer() {
+        let mut p = KeyParser::default();
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..20_000 {
+            // xorshift64: a seeded stream of arbitrary bytes.
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let bytes = state.to_le_bytes();
+            p.feed(&bytes[..(state % 8) as usize]);
+            assert!(p.pending.len() <= MAX_PENDING);
+        }
+    }
+}

@@ -1,0 +1,270 @@
+//! The view: brings the image up to date with the [`App`] (one render, or one more progressive
+//! pass in the GI stage) and encodes what the terminal must change, as one synchronized-output
+//! write. Pure apart from the clock: no terminal I/O.
+
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+use raytty::{CellGrid, FrameStats, HitCache, Image, Stage, encode_diff, render_cached};
+
+use super::app::App;
+use super::overlay::{blank, draw_help, printable, put_line, put_text};
+
+/// Smallest terminal drawn: below this a short message replaces the frame.
+pub const MIN_COLS: u16 = 10;
+/// Smallest terminal height drawn (two image rows and the status line).
+pub const MIN_ROWS: u16 = 3;
+/// Progressive refinement in the GI stage stops after this many passes (one sample per pixel
+/// each); the app is then idle.
+pub const GI_MAX_PASSES: u32 = 256;
+
+/// DEC private mode 2026: the terminal shows the frame only when it is complete.
+const SYNC_BEGIN: &[u8] = b"\x1b[?2026h";
+const SYNC_END: &[u8] = b"\x1b[?2026l";
+
+/// What the last frame cost, for the status line.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct DrawStats {
+    /// The last render's stats (rays by kind, time).
+    pub render: FrameStats,
+    /// Time spent turning the image into bytes.
+    pub encode: Duration,
+    /// Bytes of the last frame written.
+    pub bytes: usize,
+}
+
+/// The terminal's picture of the app and the buffers behind it.
+#[derive(Debug)]
+pub struct Screen {
+    cache: HitCache,
+    /// The app generation the image shows, once rendered.
+    generation: Option<u64>,
+    /// Sum of the progressive passes so far.
+    sum: Vec<Vec3>,
+    passes: u32,
+    image: Image,
+    /// What the terminal shows now.
+    shown: Option<CellGrid>,
+    /// The last frame's costs.
+    pub stats: DrawStats,
+}
+
+/// The image size for a terminal of `cols × rows` cells, or `None` if it is too small.
+pub fn image_size(size: (u16, u16)) -> Option<(u32, u32)> {
+    let (cols, rows) = size;
+    (cols >= MIN_COLS && rows >= MIN_ROWS).then(|| (cols as u32, 2 * (rows as u32 - 1)))
+}
+
+impl Screen {
+    /// A screen that has drawn nothing yet.
+    pub fn new() -> Screen {
+        Screen {
+            cache: HitCache::new(),
+            generation: None,
+            sum: Vec::new(),
+            passes: 0,
+            image: Image::new(0, 0),
+            shown: None,
+            stats: DrawStats::default(),
+        }
+    }
+
+    /// Passes accumulated for the current image.
+    pub fn passes(&self) -> u32 {
+        self.passes
+    }
+
+    /// Whether [`Screen::render`] has work to do: the app changed, or GI is still refining.
+    pub fn needs_render(&self, app: &App) -> bool {
+        image_size(app.size).is_some()
+            && (self.generation != Some(app.generation)
+                || (app.stage == Stage::Gi && self.passes < GI_MAX_PASSES))
+    }
+
+    /// Renders one frame, or one more progressive pass in the GI stage (which restarts when
+    /// the app's generation changes). Does nothing if the terminal is too small.
+    pub fn render(&mut self, app: &App) {
+        let Some((w, h)) = image_size(app.size) else {
+            return;
+        };
+        if self.generation != Some(app.generation) {
+            self.generation = Some(app.generation);
+            self.passes = 0;
+            self.sum.clear();
+        }
+        let mut settings = app.stage.settings(app.scene.effects);
+        settings.frame = self.passes;
+        let frame = render_cached(
+            &app.scene,
+            &app.camera,
+            &app.lights,
+            &settings,
+            w,
+            h,
+            &mut self.cache,
+        );
+        self.stats.render = frame.stats;
+        if app.stage == Stage::Gi {
+            self.sum.resize(frame.image.pixels.len(), Vec3::ZERO);
+            for (s, p) in self.sum.iter_mut().zip(&frame.image.pixels) {
+                *s += *p;
+            }
+            self.passes += 1;
+            let scale = 1.0 / self.passes as f32;
+            self.image = Image {
+                width: w,
+                height: h,
+                pixels: self.sum.iter().map(|&s| s * scale).collect(),
+            };
+        } else {
+            self.passes = GI_MAX_PASSES;
+            self.image = frame.image;
+        }
+    }
+
+    /// The bytes that bring the terminal up to date (empty if nothing visible changed),
+    /// wrapped in synchronized output. Remembers what the terminal now shows.
+    pub fn draw(&mut self, app: &App) -> Vec<u8> {
+        let start = Instant::now();
+        let (cols, rows) = (app.size.0 as usize, app.size.1 as usize);
+        let grid = if image_size(app.size) != Some((self.image.width, self.image.height)) {
+            let mut g = blank(cols, rows, app.color);
+            for (i, line) in ["raytty: terminal too small", "Esc quits"]
+                .iter()
+                .enumerate()
+            {
+                put_text(&mut g, 0, i, line, app.color);
+            }
+            g
+        } else {
+            let mut g = CellGrid::from_image(&self.image, app.color);
+            let status = blank(cols, 1, app.color);
+            g.rows += 1;
+            g.cells.extend(status.cells);
+            put_line(&mut g, rows - 1, &self.status(app), app.color);
+            if app.help {
+                draw_help(&mut g, app.color);
+            }
+            g
+        };
+        let mut body = Vec::new();
+        encode_diff(self.shown.as_ref(), &grid, 0, &mut body);
+        self.shown = Some(grid);
+        if body.is_empty() {
+            return body;
+        }
+        let mut out = Vec::with_capacity(body.len() + SYNC_BEGIN.len() + SYNC_END.len());
+        out.extend_from_slice(SYNC_BEGIN);
+        out.extend_from_slice(&body);
+        out.extend_from_slice(SYNC_END);
+        self.stats.encode = start.elapsed();
+        self.stats.bytes = out.len();
+        out
+    }
+
+    /// The status line: scene, stage, camera, light, costs of the last frame, colour mode.
+    fn status(&self, app: &App) -> String {
+        let key = Stage::ALL.iter().position(|&s| s == app.stage).unwrap_or(0) + 1;
+        let spp = if app.stage == Stage::Gi {
+            format!(" {}/{GI_MAX_PASSES}spp", self.passes)
+        } else {
+            String::new()
+        };
+        let c = app.camera.position;
+        let light = app
+            .light()
+            .map(|l| format!("{:.2},{:.2},{:.2}", l.x, l.y, l.z))
+            .unwrap_or_else(|| "none".into());
+        format!(
+            " {} | {key}:{}{spp} | cam {:.2},{:.2},{:.2} {:.0}° | light {light} | render {:.1}ms encode {:.1}ms {}B | {} | H help",
+            printable(&app.scene.name),
+            app.stage.name(),
+            c.x,
+            c.y,
+            c.z,
+            app.camera.yaw.to_degrees(),
+            ms(self.stats.render.elapsed),
+            ms(self.stats.encode),
+            self.stats.bytes,
+            app.color.name(),
+        )
+    }
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tui::app::{Message, update};
+    use glam::Vec3;
+    use raytty::{ColorMode, cornell_box};
+
+    fn app(cols: u16, rows: u16) -> App {
+        App::new(cornell_box(), ColorMode::TrueColor, (cols, rows))
+    }
+
+    #[test]
+    fn a_light_move_traces_no_primary_ray() {
+        let mut a = app(40, 13);
+        let mut s = Screen::new();
+        s.render(&a);
+        assert_eq!(s.stats.render.rays.primary, 40 * 24);
+        let before = s.draw(&a);
+        update(&mut a, Message::MoveLight(Vec3::new(0.1, 0.0, 0.0)));
+        assert!(s.needs_render(&a));
+        s.render(&a);
+        let r = s.stats.render.rays;
+        assert_eq!(r.primary, 0, "a light move re-traced primary rays");
+        assert!(r.shadow > 0, "a light move traces shadow rays");
+        let after = s.draw(&a);
+        assert!(!after.is_empty() && after.len() < before.len());
+        update(&mut a, Message::Walk(0.1));
+        s.render(&a);
+        assert_eq!(s.stats.render.rays.primary, 40 * 24);
+    }
+
+    #[test]
+    fn an_unchanged_app_draws_nothing_and_renders_nothing() {
+        let a = app(30, 10);
+        let mut s = Screen::new();
+        s.render(&a);
+        let first = s.draw(&a);
+        assert!(first.starts_with(SYNC_BEGIN) && first.ends_with(SYNC_END));
+        assert!(!s.needs_render(&a));
+        assert!(s.draw(&a).is_empty());
+    }
+
+    #[test]
+    fn gi_refines_until_the_cap_then_stops_and_restarts_on_a_move() {
+        let mut a = app(10, 3);
+        update(&mut a, Message::SetStage(Stage::Gi));
+        let mut s = Screen::new();
+        let mut n = 0;
+        while s.needs_render(&a) {
+            s.render(&a);
+            n += 1;
+        }
+        assert_eq!((n, s.passes()), (GI_MAX_PASSES, GI_MAX_PASSES));
+        assert!(s.status(&a).contains("256/256spp"));
+        update(&mut a, Message::Turn(0.1));
+        assert!(s.needs_render(&a));
+        s.render(&a);
+        assert_eq!(s.passes(), 1);
+    }
+
+    #[test]
+    fn a_tiny_terminal_gets_a_message_not_a_panic() {
+        for (c, r) in [(0, 0), (1, 1), (9, 40), (200, 2), (10, 3)] {
+            let a = app(c, r);
+            let mut s = Screen::new();
+            if s.needs_render(&a) {
+                s.render(&a);
+            }
+            let out = s.draw(&a);
+            assert_eq!(out.is_empty(), c == 0 || r == 0, "{c}x{r}");
+        }
+    }
+}
