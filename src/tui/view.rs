@@ -162,7 +162,7 @@ impl Screen {
         out
     }
 
-    /// The status line: scene, stage, camera, light, costs of the last frame, colour mode.
+    /// The status line: stage, camera, light, costs of the last frame, colour mode, scene.
     fn status(&self, app: &App) -> String {
         let key = Stage::ALL.iter().position(|&s| s == app.stage).unwrap_or(0) + 1;
         let spp = if app.stage == Stage::Gi {
@@ -176,8 +176,7 @@ impl Screen {
             .map(|l| format!("{:.2},{:.2},{:.2}", l.x, l.y, l.z))
             .unwrap_or_else(|| "none".into());
         format!(
-            " {} | {key}:{}{spp} | cam {:.2},{:.2},{:.2} {:.0}° | light {light} | render {:.1}ms encode {:.1}ms {}B | {} | H help",
-            printable(&app.scene.name),
+            " {key}:{}{spp}  cam {:.2},{:.2},{:.2} {:.0}°  light {light}  render {:.1}ms encode {:.1}ms {}B  {}  {}  H:help",
             app.stage.name(),
             c.x,
             c.y,
@@ -187,6 +186,7 @@ impl Screen {
             ms(self.stats.encode),
             self.stats.bytes,
             app.color.name(),
+            printable(&app.scene.name),
         )
     }
 }

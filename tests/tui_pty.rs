@@ -1,0 +1,296 @@
+//! The app end to end in a real pseudo-terminal: the built binary runs in a pty, and what it
+//! writes is parsed by a terminal emulator (vt100), so the assertions are about the screen a
+//! user would see. Every wait is a bounded deadline loop on a condition, never a bare sleep.
+
+use std::io::{Read, Write};
+use std::num::NonZeroU16;
+use std::sync::mpsc::{self, Receiver};
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system};
+use raytty::frame::Colour;
+use raytty::{CellGrid, ColorMode, Stage, cornell_box, render};
+
+/// How long any one condition may take before the test fails: generous, for a loaded machine
+/// (a 60×20 frame renders in milliseconds).
+const TIMEOUT: Duration = Duration::from_secs(30);
+/// How soon the app must exit once its pty is closed, or on a signal.
+const EXIT_WITHIN: Duration = Duration::from_secs(5);
+/// Between checks of whether the child has exited.
+const EXIT_POLL: Duration = Duration::from_millis(20);
+
+struct Session {
+    child: Box<dyn Child + Send + Sync>,
+    master: Option<Box<dyn MasterPty + Send>>,
+    writer: Option<Box<dyn Write + Send>>,
+    output: Receiver<Vec<u8>>,
+    screen: vt100::Parser,
+}
+
+impl Session {
+    /// Starts `raytty --color truecolor` in a `cols × rows` pty. If `first_frame_only`, the
+    /// reader stops after the first complete frame (so that dropping the master closes the pty).
+    fn start(cols: u16, rows: u16, first_frame_only: bool) -> Session {
+        let pair = native_pty_system()
+            .openpty(PtySize {
+                rows,
+                cols,
+                pixel_width: 0,
+                pixel_height: 0,
+            })
+            .expect("open a pty");
+        let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_raytty"));
+        cmd.args(["--color", "truecolor"]);
+        cmd.env("TERM", "xterm-256color");
+        cmd.env_remove("NO_COLOR");
+        let child = pair.slave.spawn_command(cmd).expect("spawn raytty");
+        drop(pair.slave);
+        let mut reader = pair.master.try_clone_reader().expect("pty reader");
+        let writer = pair.master.take_writer().expect("pty writer");
+        let (tx, output) = mpsc::channel();
+        std::thread::spawn(move || {
+            let mut buf = [0u8; 65536];
+            let mut seen = Vec::new();
+            while let Ok(n @ 1..) = reader.read(&mut buf) {
+                if tx.send(buf[..n].to_vec()).is_err() {
+                    break;
+                }
+                if first_frame_only {
+                    seen.extend_from_slice(&buf[..n]);
+                    if seen.windows(8).any(|w| w == b"\x1b[?2026l") {
+                        break;
+                    }
+                }
+            }
+        });
+        Session {
+            child,
+            master: Some(pair.master),
+            writer: Some(writer),
+            output,
+            screen: vt100::Parser::new(nonzero(rows), nonzero(cols), 0),
+        }
+    }
+
+    /// Reads output until `cond` holds for the screen; fails with the screen if it never does.
+    fn wait_for(&mut self, what: &str, cond: impl Fn(&vt100::Screen) -> bool) {
+        let deadline = Instant::now() + TIMEOUT;
+        while !cond(self.screen.screen()) {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.output.recv_timeout(left) {
+                Ok(bytes) => self.screen.process(&bytes),
+                Err(_) => panic!(
+                    "timed out waiting for {what}; the screen shows:\n{}",
+                    self.screen.screen().contents()
+                ),
+            }
+        }
+    }
+
+    /// Waits until the status line (the last row) contains every one of `parts`.
+    fn wait_for_status(&mut self, parts: &[&str]) {
+        let what = format!("a status line with {parts:?}");
+        self.wait_for(&what, |s| {
+            let (rows, cols) = (s.size().0.get(), s.size().1.get());
+            let line = s.contents_between(rows - 1, 0, rows - 1, cols);
+            parts.iter().all(|p| line.contains(p))
+        });
+    }
+
+    fn send(&mut self, bytes: &[u8]) {
+        let w = self.writer.as_mut().expect("the pty is open");
+        w.write_all(bytes).expect("write to the pty");
+        w.flush().expect("flush the pty");
+    }
+
+    /// Reads everything until the pty closes, then the child's exit status.
+    fn finish(&mut self) -> portable_pty::ExitStatus {
+        let deadline = Instant::now() + TIMEOUT;
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.output.recv_timeout(left) {
+                Ok(bytes) => self.screen.process(&bytes),
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+                Err(mpsc::RecvTimeoutError::Timeout) => panic!("the app did not exit"),
+            }
+        }
+        self.wait_exit(TIMEOUT)
+    }
+
+    /// The child's exit status, failing if it takes longer than `limit`.
+    fn wait_exit(&mut self, limit: Duration) -> portable_pty::ExitStatus {
+        let deadline = Instant::now() + limit;
+        loop {
+            if let Some(status) = self.child.try_wait().expect("query the child") {
+                return status;
+            }
+            if Instant::now() > deadline {
+                let _ = self.child.kill();
+                panic!("the app was still running {limit:?} later");
+            }
+            std::thread::sleep(EXIT_POLL);
+        }
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        if let Ok(None) = self.child.try_wait() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
+}
+
+/// The cells the library gives for the default view with these changes, `cols × rows` cells
+/// of image (the status line is not included).
+fn expected(cols: u16, rows: u16, camera_z: f32, light_y: f32) -> CellGrid {
+    let scene = cornell_box();
+    let mut camera = scene.camera;
+    camera.position += camera.forward() * camera_z;
+    let mut lights = scene.lights.clone();
+    lights[0].position += camera.to_world(Vec3::new(0.0, light_y, 0.0));
+    let settings = Stage::Indirect.settings(scene.effects);
+    let frame = render(
+        &scene,
+        &camera,
+        &lights,
+        &settings,
+        cols as u32,
+        2 * (rows as u32 - 1),
+    );
+    CellGrid::from_image(&frame.image, ColorMode::TrueColor)
+}
+
+fn nonzero(n: u16) -> NonZeroU16 {
+    NonZeroU16::new(n).expect("a terminal size is not zero")
+}
+
+fn rgb(c: vt100::Color) -> Option<Colour> {
+    match c {
+        vt100::Color::Rgb(r, g, b) => Some(Colour::Rgb(r, g, b)),
+        _ => None,
+    }
+}
+
+/// Whether the screen's image rows show exactly `grid` (character, background, and the
+/// foreground of half-blocks).
+fn shows(screen: &vt100::Screen, grid: &CellGrid) -> bool {
+    (0..grid.rows).all(|r| {
+        (0..grid.cols).all(|c| {
+            let want = grid.get(c, r);
+            let Some(got) = screen.cell(r as u16, c as u16) else {
+                return false;
+            };
+            let ch = got.contents().chars().next().unwrap_or(' ');
+            ch == want.ch
+                && rgb(got.bgcolor()) == want.bg
+                && (want.fg.is_none() || rgb(got.fgcolor()) == want.fg)
+        })
+    })
+}
+
+#[test]
+fn the_first_frame_shows_the_box_in_truecolor_half_blocks() {
+    // Wide enough for the whole status line.
+    let mut s = Session::start(120, 13, false);
+    let want = expected(120, 13, 0.0, 0.0);
+    s.wait_for("the default frame", |scr| shows(scr, &want));
+    let screen = s.screen.screen();
+    assert!(screen.alternate_screen() && screen.hide_cursor());
+    // The seed's walls, purple on the left and yellow on the right, as the terminal shows them:
+    // the box's front opening spans the 24-pixel-high image's middle 24 columns (48-71).
+    let left = rgb(screen.cell(6, 50).unwrap().bgcolor());
+    let right = rgb(screen.cell(6, 69).unwrap().bgcolor());
+    assert!(
+        matches!(left, Some(Colour::Rgb(r, g, b)) if r as u16 > 2 * g as u16 && b as u16 > 2 * g as u16),
+        "{left:?}"
+    );
+    assert!(
+        matches!(right, Some(Colour::Rgb(r, g, b)) if r as u16 > 2 * b as u16 && g as u16 > 2 * b as u16),
+        "{right:?}"
+    );
+    s.wait_for_status(&["5:indirect", "truecolor", "cornell"]);
+}
+
+#[test]
+fn the_light_keys_and_the_arrows_change_the_cells_they_should() {
+    let mut s = Session::start(120, 13, false);
+    s.wait_for("the default frame", |scr| {
+        shows(scr, &expected(120, 13, 0.0, 0.0))
+    });
+    s.send(b"q");
+    let lifted = expected(120, 13, 0.0, -0.1);
+    s.wait_for("the frame with the light moved up", |scr| {
+        shows(scr, &lifted)
+    });
+    s.send(b"\x1b[A");
+    let closer = expected(120, 13, 0.1, -0.1);
+    assert_ne!(lifted, closer);
+    s.wait_for("the frame after a step forward", |scr| shows(scr, &closer));
+    s.wait_for_status(&["cam 0.00,0.00,-2.90", "light 0.00,-0.60,-0.70"]);
+    s.send(b"\x1b[D");
+    s.wait_for("the frame after a turn left", |scr| {
+        !shows(scr, &closer) && scr.contents().contains("-5°")
+    });
+}
+
+#[test]
+fn a_resize_gives_a_frame_of_the_new_size() {
+    let mut s = Session::start(40, 13, false);
+    s.wait_for("the default frame", |scr| {
+        shows(scr, &expected(40, 13, 0.0, 0.0))
+    });
+    let size = PtySize {
+        rows: 20,
+        cols: 60,
+        pixel_width: 0,
+        pixel_height: 0,
+    };
+    s.master.as_ref().unwrap().resize(size).expect("resize");
+    s.screen.set_size(nonzero(20), nonzero(60));
+    let bigger = expected(60, 20, 0.0, 0.0);
+    s.wait_for("a 60x20 frame", |scr| shows(scr, &bigger));
+    s.wait_for_status(&["5:indirect"]);
+}
+
+#[test]
+fn esc_exits_0_and_leaves_the_alternate_screen() {
+    let mut s = Session::start(30, 10, false);
+    s.wait_for("the app's screen", |scr| scr.alternate_screen());
+    s.wait_for_status(&["indirect"]);
+    s.send(b"\x1b");
+    let status = s.finish();
+    assert!(status.success(), "{status:?}");
+    let screen = s.screen.screen();
+    assert!(!screen.alternate_screen(), "still on the alternate screen");
+    assert!(!screen.hide_cursor(), "the cursor is still hidden");
+}
+
+#[test]
+fn sigterm_restores_the_terminal() {
+    let mut s = Session::start(30, 10, false);
+    s.wait_for_status(&["indirect"]);
+    let pid = s.child.process_id().expect("pid");
+    let killed = std::process::Command::new("kill")
+        .args(["-TERM", &pid.to_string()])
+        .status()
+        .expect("run kill");
+    assert!(killed.success());
+    let status = s.finish();
+    assert_eq!(status.exit_code(), 128 + 15);
+    assert!(!s.screen.screen().alternate_screen());
+    assert!(!s.screen.screen().hide_cursor());
+}
+
+#[test]
+fn closing_the_pty_ends_the_app_within_seconds() {
+    let mut s = Session::start(30, 10, true);
+    s.wait_for_status(&["indirect"]);
+    // Wait for the reader to finish, so that the master below is the last handle on the pty.
+    while s.output.recv_timeout(TIMEOUT).is_ok() {}
+    drop(s.writer.take());
+    drop(s.master.take());
+    s.wait_exit(EXIT_WITHIN);
+}
