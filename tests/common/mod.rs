@@ -81,7 +81,11 @@ fn ray_axes(dir: Vec3) -> (usize, usize, usize) {
         2
     };
     let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
-    if dir[kz] < 0.0 { (ky, kx, kz) } else { (kx, ky, kz) }
+    if dir[kz] < 0.0 {
+        (ky, kx, kz)
+    } else {
+        (kx, ky, kz)
+    }
 }
 
 /// Gives the `f32` computation slack for the second-order terms the bound below leaves out
