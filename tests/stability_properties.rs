@@ -166,3 +166,37 @@ fn negative_and_far_hits_are_rejected() {
         );
     }
 }
+
+#[test]
+fn hits_pbrts_t_bound_rejected_are_found() {
+    // Two cases the sweep found (seeds 530 and 1250722): pbrt-v4's bound on t rejected real
+    // hits, on a ray whose direction is far from unit length and on a small triangle seen
+    // nearly edge-on.
+    let cases = [
+        (
+            [0.0004804902, -8.40235e-5, 0.00038503433],
+            [-0.0003445822, 0.00018353951, -0.0004147419],
+            [
+                [1.4772813e-6, 0.00014254068, -4.989718e-5],
+                [0.00013257396, 0.00010234797, -3.8410915e-5],
+                [0.00033327698, 1.193925e-5, 0.000113377624],
+            ],
+        ),
+        (
+            [-0.18742988, 0.0010918081, 0.09299265],
+            [0.19440793, 0.007297734, -0.05944923],
+            [
+                [0.0053567365, 0.019593863, 0.044397756],
+                [0.005964078, 0.005245867, 0.03099753],
+                [0.008134212, 0.008131047, 0.032912493],
+            ],
+        ),
+    ];
+    for (o, dir, v) in cases {
+        let (o, dir, v) = (Vec3::from(o), Vec3::from(dir), v.map(Vec3::from));
+        assert!(matches!(expect(o, dir, &v, MIN_T), Expect::Hit(_)));
+        if let Err(e) = check(o, dir, &v) {
+            panic!("{}: {e}", case(0, o, dir, &v));
+        }
+    }
+}

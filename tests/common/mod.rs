@@ -16,6 +16,14 @@ pub use raytty::rng::Rng;
 /// Half an ULP of 1.0 in `f32` (the unit roundoff of one `f32` operation).
 pub const EPS: f64 = f32::EPSILON as f64 * 0.5;
 
+/// Rays within this distance of a feature edge in the Cornell box (whose room is 2 wide) may
+/// go either way between `f32` and `f64`: about 15 times the rounding error of a hit point or
+/// an offset shadow-ray origin there (`γ₇·3 ≈ 1.3e-6`), and a 200th of a pixel's footprint on
+/// the back wall at 500×500. The mask it gives is dominated by the two image diagonals, whose
+/// pixel-centre rays run exactly along the room's creases (at 2e-6 it still holds 500 pixels;
+/// at 0 the shadow test fails on two diagonal pixels).
+pub const EDGE_TOL: f64 = 2e-5;
+
 /// `Vec3` to `DVec3` (exact).
 pub fn d(v: Vec3) -> DVec3 {
     v.as_dvec3()
