@@ -32,10 +32,16 @@ fn degenerate_triangles_are_rejected_with_a_clear_error() {
         ([a, a, a], DegenerateTriangle::ZeroArea),
         ([a, b, 2.0 * b], DegenerateTriangle::ZeroArea),
         ([a, b, -3.5 * b], DegenerateTriangle::ZeroArea),
-        ([a, b, Vec3::new(f32::NAN, 0.0, 0.0)], DegenerateTriangle::NonFinite),
+        (
+            [a, b, Vec3::new(f32::NAN, 0.0, 0.0)],
+            DegenerateTriangle::NonFinite,
+        ),
         ([a, Vec3::INFINITY, c], DegenerateTriangle::NonFinite),
         ([Vec3::NEG_INFINITY, b, c], DegenerateTriangle::NonFinite),
-        ([Vec3::new(0.0, f32::MAX, 0.0) * 2.0, b, c], DegenerateTriangle::NonFinite),
+        (
+            [Vec3::new(0.0, f32::MAX, 0.0) * 2.0, b, c],
+            DegenerateTriangle::NonFinite,
+        ),
     ];
     for (tri, problem) in cases {
         assert_eq!(
@@ -111,5 +117,8 @@ fn kept_slivers_have_unit_normals_and_never_give_nan() {
             }
         }
     }
-    assert!(kept > 1000, "only {kept} slivers kept: the test checks nothing");
+    assert!(
+        kept > 1000,
+        "only {kept} slivers kept: the test checks nothing"
+    );
 }
