@@ -220,6 +220,9 @@ pub fn intersect_watertight(ray: &Ray, v: &[Vec3; 3], t_max: f32) -> Option<TriH
         return None;
     }
 
+    // The sheared x and y carry rounding error in proportion to the unscaled z (|sx|, |sy| ≤ 1);
+    // keep that z for the error bound below, before it is scaled into units of t.
+    let z0 = [az.abs(), bz.abs(), cz.abs()];
     let az = ray.sz * az;
     let bz = ray.sz * bz;
     let cz = ray.sz * cz;
@@ -236,18 +239,26 @@ pub fn intersect_watertight(ray: &Ray, v: &[Vec3; 3], t_max: f32) -> Option<TriH
         return None;
     }
 
-    // Conservative bound on the error of t (pbrt-v4, section 6.8.4): reject hits that rounding
-    // cannot separate from the origin.
+    // Conservative bound on the error of t (after pbrt-v4, section 6.8.4): reject hits that
+    // rounding cannot separate from the origin. pbrt bounds all three edge functions by one
+    // error built from the largest |x|, |y| and the scaled z; tests/stability_properties.rs
+    // found real hits it rejects (small distant triangles seen nearly edge-on, and rays whose
+    // direction is not unit length, such as shadow rays). So each edge gets its own bound, and
+    // since t = Σ wᵢ·zᵢ with weights wᵢ = eᵢ/det summing to 1, a weight error moves t only by
+    // |zᵢ − t| per unit, not by the largest |z|.
+    let t_error = EdgeErrors::new([ax, bx, cx], [ay, by, cy], z0, (ray.sx, ray.sy));
     let max_zt = az.abs().max(bz.abs()).max(cz.abs());
-    let delta_z = gamma(3) * max_zt;
-    let max_xt = ax.abs().max(bx.abs()).max(cx.abs());
-    let max_yt = ay.abs().max(by.abs()).max(cy.abs());
-    let delta_x = gamma(5) * (max_xt + max_zt);
-    let delta_y = gamma(5) * (max_yt + max_zt);
-    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
-    let delta_t =
-        3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    let Some(weights_error) = t_error.weights(
+        [e0, e1, e2],
+        det,
+        [az, bz, cz].map(|z| (z - t).abs() + gamma(3) * max_zt),
+    ) else {
+        // The determinant's sign is not certain: the ray lies nearly in the triangle's plane.
+        return None;
+    };
+    // z (one γ₃), the t_scaled sum (γ₃·max|z|), the division (γ₃·t) and the weights; the
+    // factor 2 covers the second-order terms the sum leaves out.
+    let delta_t = 2.0 * (2.0 * gamma(3) * max_zt + gamma(3) * t + weights_error);
     if !(t > delta_t) {
         return None;
     }
@@ -255,6 +266,52 @@ pub fn intersect_watertight(ray: &Ray, v: &[Vec3; 3], t_max: f32) -> Option<TriH
         t,
         b: [e0 * inv_det, e1 * inv_det, e2 * inv_det],
     })
+}
+
+/// Bounds on the rounding error of the watertight test's three edge functions, each from its
+/// own operands.
+struct EdgeErrors {
+    e: [f32; 3],
+}
+
+impl EdgeErrors {
+    /// From the sheared vertex coordinates `x`, `y`, the unscaled `|z|` and the shear: each
+    /// sheared coordinate `x = (v − o)ₓ + sx·(v − o)_z` carries one rounding from `v − o`, two
+    /// from the shear constant, one from the product and one from the sum (γ₅), on terms of at
+    /// most `|x| + 2·|sx·z|` in magnitude. Edge
+    /// function `eᵢ = xⱼ·yₖ − yⱼ·xₖ` adds the errors of its inputs times the other factor, and
+    /// two roundings of its own.
+    #[inline]
+    fn new(x: [f32; 3], y: [f32; 3], z: [f32; 3], (sx, sy): (f32, f32)) -> EdgeErrors {
+        let dx = [0, 1, 2].map(|i| gamma(5) * (x[i].abs() + 2.0 * (sx * z[i]).abs()));
+        let dy = [0, 1, 2].map(|i| gamma(5) * (y[i].abs() + 2.0 * (sy * z[i]).abs()));
+        let e = [0, 1, 2].map(|i| {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            x[j].abs() * dy[k]
+                + y[k].abs() * dx[j]
+                + y[j].abs() * dx[k]
+                + x[k].abs() * dy[j]
+                + gamma(2) * ((x[j] * y[k]).abs() + (y[j] * x[k]).abs())
+        });
+        EdgeErrors { e }
+    }
+
+    /// How far errors in the weights `eᵢ/det` can move a weighted mean whose terms lie within
+    /// `spread[i]` of it: Σ (δeᵢ + |wᵢ|·Σδe)·spreadᵢ / (|det| − Σδe). `None` when the
+    /// determinant is not certain to be non-zero.
+    #[inline]
+    fn weights(&self, e: [f32; 3], det: f32, spread: [f32; 3]) -> Option<f32> {
+        let total = self.e[0] + self.e[1] + self.e[2];
+        let margin = det.abs() - total;
+        if !(margin > 0.0) {
+            return None;
+        }
+        let inv = 1.0 / det.abs();
+        let sum: f32 = (0..3)
+            .map(|i| (self.e[i] + (e[i] * inv).abs() * total) * spread[i])
+            .sum();
+        Some(sum / margin)
+    }
 }
 
 /// The hit point from barycentrics, and a conservative bound on its absolute error per axis.

@@ -1,0 +1,119 @@
+//! The `raytty render` command as a user runs it: formats, sizes, and clear errors with exit
+//! status 2 for bad flag values.
+
+use std::process::{Command, Output};
+
+fn raytty(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_raytty"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn text_formats_have_the_requested_size() {
+    let out = raytty(&["render", "--size", "30x10", "--format", "ascii"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(text.lines().count(), 10);
+    assert!(text.lines().all(|l| l.len() == 30));
+    let out = raytty(&["render", "--size", "30x10", "--format", "ansi"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(text.lines().count(), 10);
+    assert!(text.contains("\x1b[38;2;") && text.contains('▀'));
+}
+
+#[test]
+fn images_are_written_to_files() {
+    let dir = std::env::temp_dir().join(format!("raytty-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("f.png");
+    let out = raytty(&[
+        "render",
+        "--pixels",
+        "64x32",
+        "--format",
+        "png",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    let pfm = dir.join("f.pfm");
+    raytty(&[
+        "render",
+        "--pixels",
+        "64x32",
+        "--format",
+        "pfm",
+        "-o",
+        pfm.to_str().unwrap(),
+    ]);
+    let bytes = std::fs::read(&pfm).unwrap();
+    assert!(bytes.starts_with(b"PF\n64 32\n-1.0\n"));
+    assert_eq!(bytes.len(), "PF\n64 32\n-1.0\n".len() + 64 * 32 * 12);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn camera_and_light_flags_change_the_frame() {
+    let base = raytty(&["render", "--size", "20x8", "--format", "ascii"]).stdout;
+    let moved = raytty(&[
+        "render",
+        "--size",
+        "20x8",
+        "--format",
+        "ascii",
+        "--camera",
+        "0.2,0,-3,10",
+    ])
+    .stdout;
+    let lit = raytty(&[
+        "render", "--size", "20x8", "--format", "ascii", "--light", "0,-0.9,0",
+    ])
+    .stdout;
+    assert_ne!(base, moved);
+    assert_ne!(base, lit);
+}
+
+#[test]
+fn bad_values_get_a_clear_message_and_status_2() {
+    for (args, needle) in [
+        (&["render", "--size", "80by24"][..], "expected WIDTHxHEIGHT"),
+        (&["render", "--size", "0x24"], "expected WIDTHxHEIGHT"),
+        (&["render", "--format", "gif"], "possible values"),
+        (
+            &["render", "--stage", "shiny"],
+            "expected one of flat, light",
+        ),
+        (
+            &["render", "--camera", "1,2"],
+            "expected 4 comma-separated numbers",
+        ),
+        (&["render", "--light", "0,nan,0"], "out of range"),
+        (&["render", "--light", "0,x,0"], "is not a number"),
+        (
+            &[
+                "render",
+                "--pixels",
+                "60000x60000",
+                "--format",
+                "png",
+                "-o",
+                "/dev/null",
+            ],
+            "limit",
+        ),
+    ] {
+        let out = raytty(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+}
