@@ -50,6 +50,7 @@ fn main() {
         let (mut diff_bytes, mut naive_bytes) = (0, 0);
         let (mut render_t, mut encode_t) = (Duration::ZERO, Duration::ZERO);
         let mut primary = 0;
+        let mut changed = 0;
         for step in 0..=STEPS {
             if step > 0 {
                 if sweep.starts_with("light") {
@@ -71,6 +72,10 @@ fn main() {
                 render_t += frame.stats.elapsed;
                 encode_t += enc;
                 primary += frame.stats.rays.primary;
+                let before = prev.as_ref().expect("a first frame");
+                changed += (before.cells.iter().zip(&grid.cells))
+                    .filter(|(a, b)| a != b)
+                    .count();
             } else {
                 println!(
                     "{sweep}: first full frame {} bytes (naive {})",
@@ -82,10 +87,11 @@ fn main() {
         }
         let n = STEPS as f64;
         println!(
-            "{sweep}: {:.0} bytes/frame diffed vs {:.0} naive ({:.1}%), render {:.1} ms, encode {:.2} ms, primary rays/frame {}",
+            "{sweep}: {:.0} bytes/frame diffed vs {:.0} naive ({:.1}%), {:.0}% of cells changed, render {:.1} ms, encode {:.2} ms, primary rays/frame {}",
             diff_bytes as f64 / n,
             naive_bytes as f64 / n,
             100.0 * diff_bytes as f64 / naive_bytes as f64,
+            100.0 * changed as f64 / (n * (COLS * (ROWS - 1)) as f64),
             render_t.as_secs_f64() * 1e3 / n,
             encode_t.as_secs_f64() * 1e3 / n,
             primary / STEPS as u64,
