@@ -170,18 +170,12 @@ impl Screen {
         } else {
             String::new()
         };
-        let c = app.camera.position;
-        let light = app
-            .light()
-            .map(|l| format!("{:.2},{:.2},{:.2}", l.x, l.y, l.z))
-            .unwrap_or_else(|| "none".into());
+        let light = app.light().map_or_else(|| "none".into(), xyz);
         format!(
-            " {key}:{}{spp}  cam {:.2},{:.2},{:.2} {:.0}°  light {light}  render {:.1}ms encode {:.1}ms {}B  {}  {}  H:help",
+            " {key}:{}{spp}  cam {} {}°  light {light}  render {:.1}ms encode {:.1}ms {}B  {}  {}  H:help",
             app.stage.name(),
-            c.x,
-            c.y,
-            c.z,
-            app.camera.yaw.to_degrees(),
+            xyz(app.camera.position),
+            fixed(app.camera.yaw.to_degrees(), 0),
             ms(self.stats.render.elapsed),
             ms(self.stats.encode),
             self.stats.bytes,
@@ -189,6 +183,20 @@ impl Screen {
             printable(&app.scene.name),
         )
     }
+}
+
+/// `v` with `decimals` places, and no "-0" for a value that rounds to zero.
+fn fixed(v: f32, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    if s.starts_with('-') && s.chars().all(|c| matches!(c, '-' | '0' | '.')) {
+        s[1..].to_string()
+    } else {
+        s
+    }
+}
+
+fn xyz(v: Vec3) -> String {
+    format!("{},{},{}", fixed(v.x, 2), fixed(v.y, 2), fixed(v.z, 2))
 }
 
 fn ms(d: Duration) -> f64 {
@@ -249,6 +257,10 @@ mod tests {
         }
         assert_eq!((n, s.passes()), (GI_MAX_PASSES, GI_MAX_PASSES));
         assert!(s.status(&a).contains("256/256spp"));
+        assert_eq!(
+            (fixed(-0.004, 2), fixed(-0.3, 0), fixed(-5.0, 0)),
+            ("0.00".into(), "0".into(), "-5".into())
+        );
         update(&mut a, Message::Turn(0.1));
         assert!(s.needs_render(&a));
         s.render(&a);
