@@ -256,16 +256,40 @@ fn a_resize_gives_a_frame_of_the_new_size() {
 }
 
 #[test]
-fn esc_exits_0_and_leaves_the_alternate_screen() {
-    let mut s = Session::start(30, 10, false);
-    s.wait_for("the app's screen", |scr| scr.alternate_screen());
-    s.wait_for_status(&["indirect"]);
-    s.send(b"\x1b");
-    let status = s.finish();
-    assert!(status.success(), "{status:?}");
-    let screen = s.screen.screen();
-    assert!(!screen.alternate_screen(), "still on the alternate screen");
-    assert!(!screen.hide_cursor(), "the cursor is still hidden");
+fn esc_and_ctrl_c_exit_0_and_leave_the_alternate_screen() {
+    for key in [&b"\x1b"[..], b"\x03"] {
+        let mut s = Session::start(30, 10, false);
+        s.wait_for("the app's screen", |scr| scr.alternate_screen());
+        s.wait_for_status(&["indirect"]);
+        s.send(key);
+        let status = s.finish();
+        assert!(status.success(), "{key:?}: {status:?}");
+        let screen = s.screen.screen();
+        assert!(
+            !screen.alternate_screen(),
+            "{key:?}: still on the alternate screen"
+        );
+        assert!(!screen.hide_cursor(), "{key:?}: the cursor is still hidden");
+    }
+}
+
+#[test]
+fn c_cycles_the_colour_mode_live() {
+    let mut s = Session::start(120, 13, false);
+    s.wait_for_status(&["truecolor"]);
+    s.send(b"c");
+    s.wait_for("256-colour cells", |scr| {
+        matches!(
+            scr.cell(6, 50).map(|c| c.bgcolor()),
+            Some(vt100::Color::Idx(_))
+        )
+    });
+    s.wait_for_status(&[" 256 "]);
+    s.send(b"c");
+    s.wait_for("ASCII cells", |scr| {
+        scr.cell(6, 50).map(|c| c.bgcolor()) == Some(vt100::Color::Default)
+    });
+    s.wait_for_status(&["ascii"]);
 }
 
 #[test]
