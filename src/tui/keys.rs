@@ -20,9 +20,9 @@ pub const FINE: f32 = 0.2;
 pub const KEYS: &[(&str, &str)] = &[
     ("Up / Down", "move forward / back (Shift: finer)"),
     ("Left / Right", "turn left / right (Shift: finer)"),
-    ("W / S", "light forward / back"),
-    ("A / D", "light left / right"),
-    ("Q / E", "light up / down"),
+    ("W / S", "light forward / back (Shift: finer)"),
+    ("A / D", "light left / right (Shift: finer)"),
+    ("Q / E", "light up / down (Shift: finer)"),
     ("1-6", "stage: flat light direct shadows indirect gi"),
     ("R", "reset camera and light"),
     ("C", "colour mode: truecolor 256 ascii"),
