@@ -13,8 +13,6 @@
 //! assert_eq!(text.iter().filter(|&&b| b == b'\n').count(), 12);
 //! ```
 #![warn(missing_docs)]
-// `!(a > b)` is how the tracer says "not greater, or NaN": NaN must fall on the safe side.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod accel;
 pub mod camera;

@@ -135,7 +135,11 @@ fn parallel_and_grazing_rays_agree_with_the_exact_answer() {
             // At a grazing angle, down onto a point inside or outside the triangle.
             let target = plane_point(&mut rng, &v);
             for a in ANGLES {
-                let side = if rng.next_u64() % 2 == 0 { 1.0 } else { -1.0 };
+                let side = if rng.next_u64().is_multiple_of(2) {
+                    1.0
+                } else {
+                    -1.0
+                };
                 let dir = u * a.cos() - n * (side * a.sin());
                 check(seed, target - dir, dir, &v, &mut tally[2]);
             }
