@@ -20,6 +20,7 @@ pub mod cornell;
 pub mod frame;
 pub mod geometry;
 pub mod image;
+pub mod procedural;
 pub mod render;
 pub mod rng;
 pub mod scene;
