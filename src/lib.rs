@@ -15,6 +15,7 @@
 #![warn(missing_docs)]
 
 pub mod accel;
+pub mod bench;
 pub mod camera;
 pub mod cornell;
 pub mod frame;
