@@ -166,17 +166,34 @@ pub fn load_or_render(
     let partial_count = path.with_extension("partial.txt");
     let passes = spec.passes();
 
-    // Resume: the partial file holds the mean of the first `done` passes.
+    // Resume: the partial file holds the mean of the first `done` passes. Pass k is seeded by
+    // k alone, so a cached reference with fewer samples (and the same key otherwise) is the
+    // mean of this one's first passes: start from the largest one.
     let mut done = 0;
     let mut sum = vec![Vec3::ZERO; spec.width as usize * spec.height as usize];
+    let mut start_from = |img: Image, n: u32| {
+        if (img.width, img.height) == (spec.width, spec.height) && n > done && n < passes {
+            done = n;
+            for (s, p) in sum.iter_mut().zip(&img.pixels) {
+                *s = *p * n as f32;
+            }
+        }
+    };
     if let (Ok(bytes), Ok(count)) = (fs::read(&partial), fs::read_to_string(&partial_count))
         && let (Some(img), Ok(n)) = (read_pfm(&bytes), count.trim().parse::<u32>())
-        && (img.width, img.height) == (spec.width, spec.height)
-        && n < passes
     {
-        done = n;
-        for (s, p) in sum.iter_mut().zip(&img.pixels) {
-            *s = *p * n as f32;
+        start_from(img, n);
+    }
+    for fewer in (1..passes).rev() {
+        let prefix = ReferenceSpec {
+            spp: fewer * PASS_SPP,
+            ..spec.clone()
+        };
+        if let Ok(bytes) = fs::read(dir.join(prefix.file_name()))
+            && let Some(img) = read_pfm(&bytes)
+        {
+            start_from(img, fewer);
+            break;
         }
     }
 
@@ -299,6 +316,27 @@ mod tests {
         assert_eq!(read_pfm(&pfm_bytes(&img).unwrap()), Some(img));
         assert_eq!(read_pfm(b"P6\n1 1\n255\n..."), None);
         assert_eq!(read_pfm(b"PF\n2 2\n-1.0\n"), None);
+    }
+
+    /// A reference that starts from a cached one with fewer samples equals one rendered whole
+    /// (up to the rounding of mean·n), and a second call reads it from the cache.
+    #[test]
+    fn more_samples_resume_from_fewer_and_are_cached() {
+        let scene = crate::cornell::cornell_box();
+        let tmp = std::env::temp_dir().join(format!("raytty-ref-test-{}", std::process::id()));
+        let (a, b) = (tmp.join("a"), tmp.join("b"));
+        let spec = |spp| ReferenceSpec::new(&scene, 12, 10, spp, 4);
+        let (whole, info) = load_or_render(&scene, &spec(48), &a, false).unwrap();
+        assert!(!info.cached);
+        load_or_render(&scene, &spec(16), &b, false).unwrap();
+        let (resumed, _) = load_or_render(&scene, &spec(48), &b, false).unwrap();
+        for (p, q) in whole.pixels.iter().zip(&resumed.pixels) {
+            assert!((*p - *q).abs().max_element() <= 1e-5 * p.max_element().max(1.0));
+        }
+        let (again, info) = load_or_render(&scene, &spec(48), &b, false).unwrap();
+        assert!(info.cached && info.describe().contains("read from the cache"));
+        assert_eq!(again, resumed);
+        let _ = fs::remove_dir_all(&tmp);
     }
 
     #[test]
