@@ -74,6 +74,37 @@ pub fn markdown(report: &BenchReport, command: &str) -> String {
             seed.rmse,
             psnr(seed.psnr)
         );
+        let rate: Vec<String> = crate::bench::GI_BOUNCES
+            .iter()
+            .filter_map(|&b| {
+                report
+                    .rows
+                    .iter()
+                    .filter(|r| {
+                        (r.width, r.height) == (seed.width, seed.height)
+                            && r.kind.bounces() == Some(b)
+                    })
+                    .max_by_key(|r| r.kind.spp())
+            })
+            .map(|r| {
+                let samples = f64::from(r.width) * f64::from(r.height) * f64::from(r.kind.spp());
+                format!(
+                    "{:.2} M/s with {} bounce{} ({} spp)",
+                    samples / (r.median_ms * 1e-3).max(1e-9) / 1e6,
+                    r.kind.bounces().unwrap_or(0),
+                    if r.kind.bounces() == Some(1) { "" } else { "s" },
+                    r.kind.spp()
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "- at {}x{} the seed's frame takes {:.1} ms; GI samples per second: {}",
+            seed.width,
+            seed.height,
+            seed.median_ms,
+            rate.join(", ")
+        );
     }
     s
 }
@@ -175,6 +206,9 @@ const COLOURS: [&str; 6] = [
 
 const PANEL_W: f64 = 520.0;
 const PANEL_H: f64 = 400.0;
+/// Vertical distance between two labels' baselines, in pixels (the font is 11 px).
+const LABEL_GAP: f64 = 12.0;
+
 /// Plot margins inside a panel: left (y labels), right, top (title), bottom (x labels).
 const MARGIN: (f64, f64, f64, f64) = (64.0, 150.0, 36.0, 44.0);
 
@@ -316,21 +350,41 @@ fn panel(s: &mut String, x0: f64, w: u32, h: u32, rows: &[&Row]) {
             if *b == 1 { "" } else { "s" }
         );
     }
-    // The seed's stages and anti-aliasing: labelled points.
-    for r in rows.iter().filter(|r| r.kind.bounces().is_none()) {
-        let (cx, cy) = (x(r.median_ms), y(r.rmse));
-        let label = match r.kind {
-            RowKind::Aa { spp } => format!("AA {spp} spp"),
-            RowKind::Stage(st) => st.name().to_string(),
-            RowKind::Gi { .. } => continue,
+    // The seed's stages and anti-aliasing: labelled points. Labels that would overlap (points
+    // close in time and error) are pushed down, top to bottom.
+    let mut points: Vec<(f64, f64, String)> = rows
+        .iter()
+        .filter_map(|r| {
+            let label = match r.kind {
+                RowKind::Aa { spp } => format!("AA {spp} spp"),
+                RowKind::Stage(st) => st.name().to_string(),
+                RowKind::Gi { .. } => return None,
+            };
+            Some((x(r.median_ms), y(r.rmse), label))
+        })
+        .collect();
+    points.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let mut placed: Vec<(f64, f64, f64)> = Vec::new(); // label x from, x to, baseline
+    for (cx, cy, label) in points {
+        let width = 6.0 * label.chars().count() as f64;
+        // Right of the point, or left of it where the plot's right edge is near.
+        let lx = if cx + 5.0 + width > px1 {
+            cx - 5.0 - width
+        } else {
+            cx + 5.0
         };
+        let mut ly = cy - 4.0;
+        for &(x0, x1, y0) in &placed {
+            if lx < x1 && x0 < lx + width && ly < y0 + LABEL_GAP {
+                ly = y0 + LABEL_GAP;
+            }
+        }
+        placed.push((lx, lx + width, ly));
         let _ = writeln!(
             s,
-            r##"<rect class="stage" x="{:.1}" y="{:.1}" width="5" height="5" fill="#222"/><text x="{:.1}" y="{:.1}" fill="#222">{}</text>"##,
+            r##"<rect class="stage" x="{:.1}" y="{:.1}" width="5" height="5" fill="#222"/><text x="{lx:.1}" y="{ly:.1}" fill="#222">{}</text>"##,
             cx - 2.5,
             cy - 2.5,
-            cx + 5.0,
-            cy - 4.0,
             escape(&label)
         );
     }
