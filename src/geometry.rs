@@ -550,6 +550,36 @@ mod tests {
     }
 
     #[test]
+    fn t_error_bound_is_small_head_on_and_none_in_the_plane() {
+        let v = [
+            Vec3::new(-1.0, -1.0, 1.0),
+            Vec3::new(1.0, -1.0, 1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ];
+        // A direction far from unit length, as a shadow ray's `light − p` can be: the bound
+        // stays a few ulps of t (pbrt-v4's grows with t², see `t_error_bound`).
+        let ray = Ray::new(Vec3::ZERO, Vec3::Z * 1e-3);
+        let frame = ray.frame(&v);
+        let e = frame.edge_functions();
+        let hit = intersect_watertight(&ray, &v, f32::INFINITY).expect("head-on hit");
+        let bound = t_error_bound(&ray, &frame, e, hit.t).expect("a bound exists");
+        assert!((hit.t - 1000.0).abs() <= bound, "{hit:?} {bound}");
+        assert!(
+            bound > 0.0 && bound < hit.t * 1e-5,
+            "{bound} for t = {}",
+            hit.t
+        );
+        // In the triangle's plane the determinant is zero: no bound, no hit.
+        let ray = Ray::new(Vec3::new(-2.0, 0.0, 1.0), Vec3::X);
+        let frame = ray.frame(&v);
+        assert_eq!(
+            t_error_bound(&ray, &frame, frame.edge_functions(), 2.0),
+            None
+        );
+        assert_eq!(intersect_watertight(&ray, &v, f32::INFINITY), None);
+    }
+
+    #[test]
     fn degenerate_triangles_are_rejected() {
         let a = Vec3::ZERO;
         let b = Vec3::X;
