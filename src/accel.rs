@@ -80,10 +80,19 @@ pub struct AccelStats {
 }
 
 /// A scene's acceleration structure.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct Accel {
     structure: Structure,
     stats: AccelStats,
+}
+
+/// Shows the structure but not its build time, so that two builds of one scene print the same.
+impl std::fmt::Debug for Accel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Accel")
+            .field("structure", &self.structure)
+            .finish_non_exhaustive()
+    }
 }
 
 #[derive(Clone, Debug)]

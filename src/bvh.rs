@@ -62,13 +62,14 @@ fn far_widen() -> f32 {
     1.0 + 2.0 * gamma(3)
 }
 
-/// One node: a box, and either two children or a run of triangles. 32 bytes.
+/// One node: a box, and either two children (adjacent: a [`NodePair`]) or a run of triangles.
+/// 32 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub(crate) struct Node {
     min: Vec3,
-    /// Leaf: index of its first triangle in leaf order. Interior: distance from this node to
-    /// its second child (the first child is the next node).
+    /// Leaf: index of its first triangle in leaf order. Interior: index of its first child
+    /// (even; the second child follows it in the same pair).
     offset: u32,
     max: Vec3,
     /// Leaf: number of triangles (at least 1). Interior: 0.
@@ -77,7 +78,20 @@ pub(crate) struct Node {
 
 const _: () = assert!(std::mem::size_of::<Node>() == 32);
 
+/// Two sibling nodes, aligned to share one 64-byte cache line: traversal tests both.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
+pub(crate) struct NodePair(pub(crate) [Node; 2]);
+
 impl Node {
+    /// Filler for the root's pair (never visited).
+    const UNUSED: Node = Node {
+        min: Vec3::INFINITY,
+        offset: 0,
+        max: Vec3::NEG_INFINITY,
+        count: 0,
+    };
+
     #[inline]
     fn is_leaf(&self) -> bool {
         self.count > 0
@@ -110,7 +124,9 @@ impl Node {
 /// A bounding volume hierarchy over a list of triangles.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Bvh {
-    nodes: Vec<Node>,
+    /// Sibling pairs in depth-first order; the root alone in the first. Node `i` is
+    /// `nodes[i / 2].0[i % 2]`.
+    nodes: Vec<NodePair>,
     /// Vertices in leaf order.
     vertices: Vec<[Vec3; 3]>,
     /// Scene index of each entry of `vertices`.
@@ -133,7 +149,7 @@ impl Bvh {
             .map(|&i| triangles[i as usize].v)
             .collect();
         Bvh {
-            nodes: built.nodes,
+            nodes: built.pairs,
             vertices,
             ids: built.order,
             depth: built.depth,
@@ -142,7 +158,12 @@ impl Bvh {
 
     /// Number of nodes.
     pub fn nodes(&self) -> usize {
-        self.nodes.len()
+        (2 * self.nodes.len()).saturating_sub(1)
+    }
+
+    #[inline(always)]
+    fn node(&self, i: usize) -> &Node {
+        &self.nodes[i >> 1].0[i & 1]
     }
 
     /// Number of levels (0 when empty, 1 for a single leaf).
@@ -152,12 +173,14 @@ impl Bvh {
 
     /// Number of leaves.
     pub fn leaves(&self) -> usize {
-        self.nodes.iter().filter(|n| n.is_leaf()).count()
+        (0..self.nodes())
+            .filter(|&i| self.node(i).is_leaf())
+            .count()
     }
 
     /// The closest hit with `t < t_max` (ties go to the lowest scene index), or `None`.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let root = self.nodes.first()?;
+        let root = &self.nodes.first()?.0[0];
         let (o, inv) = (ray.origin, ray.inv_dir);
         let mut bound = cull_bound(t_max);
         root.enter(o, inv, bound)?;
@@ -167,7 +190,7 @@ impl Bvh {
         let mut sp = 0;
         let mut i = 0usize;
         loop {
-            let node = &self.nodes[i];
+            let node = self.node(i);
             if node.is_leaf() {
                 let first = node.offset as usize;
                 for k in first..first + node.count as usize {
@@ -186,9 +209,11 @@ impl Bvh {
                     }
                 }
             } else {
-                let (a, b) = (i + 1, i + node.offset as usize);
-                let ta = self.nodes[a].enter(o, inv, bound);
-                let tb = self.nodes[b].enter(o, inv, bound);
+                let a = node.offset as usize;
+                let b = a + 1;
+                let pair = &self.nodes[a >> 1].0;
+                let ta = pair[0].enter(o, inv, bound);
+                let tb = pair[1].enter(o, inv, bound);
                 match (ta, tb) {
                     (Some(ta), Some(tb)) => {
                         // Nearer child first; the other waits with its entry distance.
@@ -226,7 +251,7 @@ impl Bvh {
 
     /// Whether some triangle has a hit with `t < t_max` (stops at the first found).
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        let Some(root) = self.nodes.first() else {
+        let Some(NodePair([root, _])) = self.nodes.first() else {
             return false;
         };
         let (o, inv) = (ray.origin, ray.inv_dir);
@@ -238,7 +263,7 @@ impl Bvh {
         let mut sp = 0;
         let mut i = 0usize;
         loop {
-            let node = &self.nodes[i];
+            let node = self.node(i);
             if node.is_leaf() {
                 let first = node.offset as usize;
                 if self.vertices[first..first + node.count as usize]
@@ -248,9 +273,11 @@ impl Bvh {
                     return true;
                 }
             } else {
-                let (a, b) = (i + 1, i + node.offset as usize);
-                let ha = self.nodes[a].enter(o, inv, bound).is_some();
-                let hb = self.nodes[b].enter(o, inv, bound).is_some();
+                let a = node.offset as usize;
+                let b = a + 1;
+                let pair = &self.nodes[a >> 1].0;
+                let ha = pair[0].enter(o, inv, bound).is_some();
+                let hb = pair[1].enter(o, inv, bound).is_some();
                 if ha {
                     if hb {
                         stack[sp] = b as u32;

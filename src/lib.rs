@@ -25,6 +25,7 @@ pub mod procedural;
 pub mod render;
 pub mod rng;
 pub mod scene;
+pub mod scene_bench;
 pub mod shading;
 
 pub use accel::{AccelKind, AccelStats, Hit};

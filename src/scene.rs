@@ -273,6 +273,12 @@ impl Scene {
         self
     }
 
+    /// A new acceleration structure of `kind` over this scene's triangles (for timing builds;
+    /// [`Scene::with_accel`] installs one).
+    pub fn build_accel(&self, kind: AccelKind) -> Accel {
+        Accel::build_kind(&self.triangles, &self.objects, kind)
+    }
+
     /// The acceleration structure's kind, size and build time.
     pub fn accel_stats(&self) -> AccelStats {
         self.accel.stats()
