@@ -15,6 +15,7 @@
 #![warn(missing_docs)]
 
 pub mod accel;
+pub mod bench;
 pub mod bvh;
 pub mod camera;
 pub mod cornell;
