@@ -10,7 +10,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
-use raytty::{CellGrid, ColorMode, PointLight, Scene, Stage, cornell_box, encode_text, render};
+use raytty::{CellGrid, ColorMode, PointLight, Scene, Stage, encode_text, render};
 
 /// Renders the Cornell box (or another scene) by ray tracing, in the terminal.
 ///
@@ -27,6 +27,10 @@ pub struct Cli {
     /// ssh does not forward COLORTERM: pass --color truecolor (or press C) to get it back.
     #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
     color: ColorChoice,
+    /// The scene: a scene file (a path that exists or ends in .toml) or a built-in scene's name
+    /// (`raytty scenes` lists them). Default: the Cornell box.
+    #[arg(long, global = true, value_name = "PATH|NAME")]
+    scene: Option<String>,
 }
 
 /// The `--color` choices.
@@ -61,6 +65,8 @@ fn resolve_color(choice: ColorChoice, no_color: bool, colorterm: Option<&str>) -
 enum Command {
     /// Render one frame to stdout or a file (text frames or images).
     Render(RenderArgs),
+    /// List the built-in scenes with their triangle counts.
+    Scenes,
 }
 
 /// Output formats of `raytty render`.
@@ -175,8 +181,14 @@ pub fn main() -> ExitCode {
         std::env::var("COLORTERM").ok().as_deref(),
     );
     let result = match cli.command {
-        Some(Command::Render(args)) => run_render(&args).map(|()| ExitCode::SUCCESS),
-        None => run_default(color),
+        Some(Command::Render(args)) => {
+            run_render(&args, cli.scene.as_deref()).map(|()| ExitCode::SUCCESS)
+        }
+        Some(Command::Scenes) => io::stdout()
+            .write_all(crate::scene_arg::list().as_bytes())
+            .map(|()| ExitCode::SUCCESS)
+            .map_err(Into::into),
+        None => run_default(color, cli.scene.as_deref()),
     };
     match result {
         Ok(code) => code,
@@ -213,29 +225,31 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
 
 /// No command: the app on a terminal; otherwise one frame to stdout, as `raytty render` with
 /// its defaults would print in `color`.
-fn run_default(color: ColorMode) -> Result<ExitCode> {
+fn run_default(color: ColorMode, scene: Option<&str>) -> Result<ExitCode> {
     #[cfg(feature = "tui")]
     if io::stdout().is_terminal() {
-        return crate::tui::run(cornell_box(), color);
+        return crate::tui::run(crate::scene_arg::load_scene(scene)?, color);
     }
-    run_render(&RenderArgs {
-        size: (80, 24),
-        pixels: None,
-        format: match color {
-            ColorMode::TrueColor => Format::Ansi,
-            ColorMode::Ansi256 => Format::Ansi256,
-            ColorMode::Ascii => Format::Ascii,
+    run_render(
+        &RenderArgs {
+            size: (80, 24),
+            pixels: None,
+            format: match color {
+                ColorMode::TrueColor => Format::Ansi,
+                ColorMode::Ansi256 => Format::Ansi256,
+                ColorMode::Ascii => Format::Ascii,
+            },
+            stage: Stage::Indirect,
+            camera: None,
+            light: None,
+            output: None,
         },
-        stage: Stage::Indirect,
-        camera: None,
-        light: None,
-        output: None,
-    })?;
+        scene,
+    )?;
     Ok(ExitCode::SUCCESS)
 }
 
-fn run_render(args: &RenderArgs) -> Result<()> {
-    let scene = cornell_box();
+fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
     let image_format = matches!(args.format, Format::Png | Format::Pfm);
     let (w, h) = match (args.pixels, image_format) {
         (Some(p), _) => p,
@@ -249,6 +263,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
             pixels * 48 / (1024 * 1024)
         )));
     }
+    let scene = crate::scene_arg::load_scene(scene)?;
     let mut camera = scene.camera;
     if let Some([x, y, z, yaw]) = args.camera {
         camera.position = Vec3::new(x, y, z);

@@ -5,10 +5,10 @@
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use raytty::{CellGrid, FrameStats, HitCache, Image, Stage, encode_diff, render_cached};
+use raytty::{CellGrid, FrameStats, HitCache, Image, Stage, encode_diff, printable, render_cached};
 
 use super::app::App;
-use super::overlay::{blank, draw_help, printable, put_line, put_text};
+use super::overlay::{blank, draw_help, put_line, put_text};
 
 /// Smallest terminal drawn: below this a short message replaces the frame.
 pub const MIN_COLS: u16 = 10;
