@@ -102,7 +102,7 @@ fn transforms_scale_then_rotate_then_translate() {
 #[test]
 fn the_scene_name_comes_from_the_file_and_keeps_its_characters() {
     let scene = scenefile::parse(
-        "name = \"box\\u001b[2J\"\n",
+        "name = \"box\\u001b[2J\"\n[material.m]\ncolour = [1, 1, 1]\n[[object]]\nkind = \"box\"\nmaterial = \"m\"\ncentre = [0, 0, 0]\nsize = [1, 1, 1]\n",
         "n.toml",
         "n",
         &scenefile::no_meshes,

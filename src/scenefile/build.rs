@@ -254,6 +254,13 @@ pub fn build(
         }
     }
 
+    if spec.object.is_empty() {
+        return Err(cx.err(
+            0,
+            "the scene has no objects: add an [[object]] table (scenes/example.toml shows every kind)",
+        ));
+    }
+
     let name = spec.name.as_ref().map_or(name, |n| n.get_ref().as_str());
     // Everything the builder checks was checked above with a position; this is a safety net.
     b.build(name, camera, effects)
@@ -300,7 +307,7 @@ fn object_triangles(
             return Err(cx.err(
                 at,
                 format!(
-                    "`{key}` does not apply to a `{kind}` object: it takes {}",
+                    "`{key}` is not a key of kind = \"{kind}\" objects: they take {}",
                     keys.join(", ")
                 ),
             ));
@@ -560,6 +567,11 @@ fn toml_error(cx: &Ctx, e: &toml::de::Error) -> SceneFileError {
     } else {
         message
             .replace("duplicate field", "duplicate key")
+            .replace(" as i128", "")
+            .replace(
+                "expected an array of length 3",
+                "expected three numbers [a, b, c]",
+            )
             .replace("expected i64", "expected a whole number")
             .replace("expected f64", "expected a number")
             .replace("expected a boolean", "expected true or false")
