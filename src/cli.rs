@@ -93,9 +93,9 @@ struct RenderArgs {
     /// Image size in pixels, WxH (default 500x500 for png and pfm; overrides --size).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pixels: Option<(u32, u32)>,
-    /// Output format.
-    #[arg(long, value_enum, default_value_t = Format::Ansi)]
-    format: Format,
+    /// Output format (default: from the -o file's extension, .png or .pfm; else ansi).
+    #[arg(long, value_enum)]
+    format: Option<Format>,
     /// Shading stage: flat, light, direct, shadows, indirect (the default) or gi.
     #[arg(long, value_parser = parse_stage, default_value = "indirect")]
     stage: Stage,
@@ -234,11 +234,11 @@ fn run_default(color: ColorMode, scene: Option<&str>) -> Result<ExitCode> {
         &RenderArgs {
             size: (80, 24),
             pixels: None,
-            format: match color {
+            format: Some(match color {
                 ColorMode::TrueColor => Format::Ansi,
                 ColorMode::Ansi256 => Format::Ansi256,
                 ColorMode::Ascii => Format::Ascii,
-            },
+            }),
             stage: Stage::Indirect,
             camera: None,
             light: None,
@@ -250,7 +250,10 @@ fn run_default(color: ColorMode, scene: Option<&str>) -> Result<ExitCode> {
 }
 
 fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
-    let image_format = matches!(args.format, Format::Png | Format::Pfm);
+    let format = args
+        .format
+        .unwrap_or_else(|| format_for(args.output.as_deref()));
+    let image_format = matches!(format, Format::Png | Format::Pfm);
     let (w, h) = match (args.pixels, image_format) {
         (Some(p), _) => p,
         (None, true) => (500, 500),
@@ -281,17 +284,17 @@ fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
             if image_format && io::stdout().is_terminal() {
                 bail!(UsageError(format!(
                     "--format {:?} writes binary data: give -o FILE or redirect stdout",
-                    args.format
+                    format
                 )));
             }
             Box::new(BufWriter::new(io::stdout().lock()))
         }
     };
-    match args.format {
+    match format {
         Format::Png => frame.image.write_png(&mut out)?,
         Format::Pfm => frame.image.write_pfm(&mut out)?,
         Format::Ansi | Format::Ansi256 | Format::Ascii => {
-            let mode = match args.format {
+            let mode = match format {
                 Format::Ansi => ColorMode::TrueColor,
                 Format::Ansi256 => ColorMode::Ansi256,
                 _ => ColorMode::Ascii,
@@ -301,6 +304,20 @@ fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
     }
     out.flush()?;
     Ok(())
+}
+
+/// The format an output file's extension implies: `.png` and `.pfm` are images, anything else
+/// (and stdout) gets truecolor text.
+fn format_for(output: Option<&std::path::Path>) -> Format {
+    let ext = output
+        .and_then(|p| p.extension())
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png") => Format::Png,
+        Some("pfm") => Format::Pfm,
+        _ => Format::Ansi,
+    }
 }
 
 /// The scene's lights, with the first one moved to `light` if given.
@@ -315,6 +332,15 @@ fn lights_with(scene: &Scene, light: Option<Vec3>) -> Vec<PointLight> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn output_extension_picks_the_format() {
+        use std::path::Path;
+        assert_eq!(format_for(Some(Path::new("a.png"))), Format::Png);
+        assert_eq!(format_for(Some(Path::new("dir/A.PFM"))), Format::Pfm);
+        assert_eq!(format_for(Some(Path::new("frame.txt"))), Format::Ansi);
+        assert_eq!(format_for(None), Format::Ansi);
+    }
 
     #[test]
     fn auto_colour_follows_no_color_then_colorterm() {
