@@ -4,6 +4,7 @@
 use std::collections::HashMap;
 
 use glam::Vec3;
+use rayon::prelude::*;
 use toml::Spanned;
 
 use super::error::{SceneFileError, did_you_mean};
@@ -452,29 +453,48 @@ fn object_triangles(
             Origin::Scene(a as usize)
         }
     };
-    if let Some((i, problem)) = tris.iter().enumerate().find_map(|(i, &[a, b, c])| {
-        let far = [a, b, c].iter().any(|v| v.abs().max_element() > MAX_COORDINATE as f32);
-        if far {
-            return Some((i, format!("a vertex is beyond ±{MAX_COORDINATE:e} after the object's transform: make the scale or translate smaller")));
-        }
-        Triangle::new(a, b, c, 0).err().map(|e| {
-            (i, format!("degenerate triangle: {e}; every triangle needs three distinct vertices that are not on one line"))
-        })
-    }) {
+    // In parallel (a procedural mesh has a million triangles); the first bad one is reported.
+    let bad = tris
+        .par_iter()
+        .position_first(|&t| triangle_problem(t).is_some());
+    if let Some(i) = bad {
+        let problem = triangle_problem(tris[i]).unwrap_or_default();
         return Err(match origin(i) {
             Origin::Scene(offset) => cx.err(offset, problem),
             Origin::Mesh { file, line, column } => SceneFileError {
                 file: crate::frame::printable(file),
                 line: line as usize,
                 column: column as usize,
-                message: crate::frame::printable(&format!("{problem} (after the transform at {}:{})", cx.file, {
-                    let (l, c) = line_column(cx.source, object.span().start);
-                    format!("{l}:{c}")
-                })),
+                message: crate::frame::printable(&format!(
+                    "{problem} (after the transform at {}:{})",
+                    cx.file,
+                    {
+                        let (l, c) = line_column(cx.source, object.span().start);
+                        format!("{l}:{c}")
+                    }
+                )),
             },
         });
     }
     Ok(tris)
+}
+
+/// What is wrong with a transformed triangle, if anything: a vertex beyond the coordinate
+/// limit, or a degenerate shape the scene would reject.
+fn triangle_problem([a, b, c]: [Vec3; 3]) -> Option<String> {
+    if [a, b, c]
+        .iter()
+        .any(|v| !(v.abs().max_element() <= MAX_COORDINATE as f32))
+    {
+        return Some(format!(
+            "a vertex is beyond ±{MAX_COORDINATE:e} after the object's transform: make the scale or translate smaller"
+        ));
+    }
+    Triangle::new(a, b, c, 0).err().map(|e| {
+        format!(
+            "degenerate triangle: {e}; every triangle needs three distinct vertices that are not on one line"
+        )
+    })
 }
 
 /// Applies the object's scale, then rotation about y, then translation, each only if given
