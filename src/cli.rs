@@ -61,6 +61,41 @@ fn resolve_color(choice: ColorChoice, no_color: bool, colorterm: Option<&str>) -
 enum Command {
     /// Render one frame to stdout or a file (text frames or images).
     Render(RenderArgs),
+    /// Measure what each step of accuracy costs: time per frame against error from a cached
+    /// path-traced reference (a Markdown table, or CSV; an SVG plot; the README's table).
+    Bench(BenchArgs),
+}
+
+/// Options of `raytty bench`.
+#[derive(Args, Debug)]
+struct BenchArgs {
+    /// Image sizes in pixels, comma-separated (default 500x500,200x100).
+    #[arg(long, value_name = "WxH,...", value_parser = parse_size, value_delimiter = ',')]
+    sizes: Vec<(u32, u32)>,
+    /// Timed runs per row, after a warm-up (default 5).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    runs: Option<u32>,
+    /// GI rows go 1, 4, 16, … samples per pixel up to this (default 64).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    max_spp: Option<u32>,
+    /// The reference's samples per pixel (default 1024).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    ref_spp: Option<u32>,
+    /// The reference's maximum bounces (default 16).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    ref_bounces: Option<u32>,
+    /// Print CSV instead of the Markdown table.
+    #[arg(long)]
+    csv: bool,
+    /// Write the error-against-time plot (log axes) to PATH as SVG.
+    #[arg(long, value_name = "PATH")]
+    svg: Option<PathBuf>,
+    /// Rewrite the table between <!-- bench:start --> and <!-- bench:end --> in PATH.
+    #[arg(long, value_name = "PATH")]
+    readme: Option<PathBuf>,
+    /// Tiny sizes, 2 runs, a small reference: seconds, for tests.
+    #[arg(long)]
+    quick: bool,
 }
 
 /// Output formats of `raytty render`.
@@ -176,6 +211,34 @@ pub fn main() -> ExitCode {
     );
     let result = match cli.command {
         Some(Command::Render(args)) => run_render(&args).map(|()| ExitCode::SUCCESS),
+        Some(Command::Bench(a)) => {
+            let request = raytty::bench::BenchRequest {
+                quick: a.quick,
+                sizes: a.sizes,
+                runs: a.runs,
+                max_spp: a.max_spp,
+                ref_spp: a.ref_spp,
+                ref_bounces: a.ref_bounces,
+                csv: a.csv,
+                svg: a.svg,
+                readme: a.readme,
+                command: std::iter::once("raytty".to_string())
+                    .chain(std::env::args().skip(1))
+                    .collect::<Vec<_>>()
+                    .join(" "),
+            };
+            raytty::bench::run_command(
+                &cornell_box(),
+                &request,
+                &mut io::stdout().lock(),
+                &mut io::stderr().lock(),
+            )
+            .map(|()| ExitCode::SUCCESS)
+            .map_err(|e| match e {
+                raytty::bench::BenchError::Usage(m) => UsageError(m).into(),
+                e => anyhow::Error::new(e),
+            })
+        }
         None => run_default(color),
     };
     match result {

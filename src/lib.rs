@@ -15,6 +15,8 @@
 #![warn(missing_docs)]
 
 pub mod accel;
+pub mod bench;
+pub mod bvh;
 pub mod camera;
 pub mod cornell;
 pub mod frame;
@@ -24,9 +26,10 @@ pub mod procedural;
 pub mod render;
 pub mod rng;
 pub mod scene;
+pub mod scene_bench;
 pub mod shading;
 
-pub use accel::Hit;
+pub use accel::{AccelKind, AccelStats, Hit};
 pub use camera::Camera;
 pub use cornell::cornell_box;
 pub use frame::{CellGrid, ColorMode, encode_diff, encode_text};
