@@ -334,9 +334,9 @@ pub fn intersect_watertight(ray: &Ray, v: &[Vec3; 3], t_max: f32) -> Option<TriH
 /// one error built from the largest |x|, |y| and the largest *scaled* |z|, and multiplies it by
 /// the largest |z|. Two consequences reject real hits, as `tests/stability_properties.rs` found:
 /// - the sheared x and y carry error in proportion to the *unscaled* z (|sx|, |sy| ≤ 1); using
-///   the scaled z, which is z/d_z, overstates it by 1/|d_z|: a ray whose direction is much
-///   shorter than 1 (a shadow ray towards a close light, `dir = light − p`) gets a bound larger
-///   than its t;
+///   the scaled z, which is z/d_z, overstates it by 1/|d_z| or more: a ray whose direction is
+///   much shorter than 1 (a shadow ray towards a close light, `dir = light − p`) gets a bound
+///   larger than its t;
 /// - multiplying the weights' error by the largest depth instead of the depths' spread about t
 ///   overstates it by t/(depth extent): a small, distant triangle seen nearly edge-on has a
 ///   small det and a large t, and pbrt's bound exceeds t.
