@@ -206,9 +206,7 @@ impl Bvh {
 
     /// Number of leaves.
     pub fn leaves(&self) -> usize {
-        (0..self.nodes())
-            .filter(|&i| self.node(i).is_leaf())
-            .count()
+        self.all_nodes().filter(|n| n.is_leaf()).count()
     }
 
     /// The closest hit with `t < t_max` (ties go to the lowest scene index), or `None`.
