@@ -37,6 +37,12 @@ impl ColorMode {
     }
 }
 
+/// `s` without control characters (C0, DEL, C1): safe to show in a terminal. Text from outside
+/// (a scene's name, a path, a key from a scene file) goes through this before it is shown.
+pub fn printable(s: &str) -> String {
+    s.chars().filter(|c| !c.is_control()).collect()
+}
+
 /// A terminal colour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Colour {

@@ -32,6 +32,11 @@ impl Session {
     /// Starts `raytty --color truecolor` in a `cols × rows` pty. If `first_frame_only`, the
     /// reader stops after the first complete frame (so that dropping the master closes the pty).
     fn start(cols: u16, rows: u16, first_frame_only: bool) -> Session {
+        Session::start_with(cols, rows, first_frame_only, &[])
+    }
+
+    /// [`Session::start`] with more arguments for raytty.
+    fn start_with(cols: u16, rows: u16, first_frame_only: bool, args: &[&str]) -> Session {
         let pair = native_pty_system()
             .openpty(PtySize {
                 rows,
@@ -42,6 +47,7 @@ impl Session {
             .expect("open a pty");
         let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_raytty"));
         cmd.args(["--color", "truecolor"]);
+        cmd.args(args);
         cmd.env("TERM", "xterm-256color");
         cmd.env_remove("NO_COLOR");
         let child = pair.slave.spawn_command(cmd).expect("spawn raytty");
@@ -317,4 +323,15 @@ fn closing_the_pty_ends_the_app_within_seconds() {
     drop(s.writer.take());
     drop(s.master.take());
     s.wait_exit(EXIT_WITHIN);
+}
+
+#[test]
+fn the_app_shows_the_scene_given_with_scene() {
+    let mut s = Session::start_with(120, 13, false, &["--scene", "lights"]);
+    s.wait_for_status(&["lights", "5:indirect"]);
+    // Three coloured lights on white walls: the frame is not the Cornell box's.
+    let cornell = expected(120, 13, 0.0, 0.0);
+    assert!(!shows(s.screen.screen(), &cornell));
+    s.send(b"\x03");
+    assert!(s.finish().success());
 }

@@ -3,7 +3,7 @@
 //! characters first, so nothing shown can send escapes to the terminal.
 
 use raytty::frame::{Cell, Colour};
-use raytty::{CellGrid, ColorMode};
+use raytty::{CellGrid, ColorMode, printable};
 
 use super::keys::KEYS;
 
@@ -17,11 +17,6 @@ fn text_colours(mode: ColorMode) -> (Option<Colour>, Option<Colour>) {
         ColorMode::Ansi256 => (Some(Colour::Indexed(254)), Some(Colour::Indexed(236))),
         ColorMode::Ascii => (None, None),
     }
-}
-
-/// `s` without control characters (C0, DEL, C1): safe to show in a terminal.
-pub fn printable(s: &str) -> String {
-    s.chars().filter(|c| !c.is_control()).collect()
 }
 
 /// Writes `text` into `grid` at (`col`, `row`), clipped to the grid, in text colours.

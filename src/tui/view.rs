@@ -5,10 +5,10 @@
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use raytty::{CellGrid, FrameStats, HitCache, Image, Stage, encode_diff, render_cached};
+use raytty::{CellGrid, FrameStats, HitCache, Image, Stage, encode_diff, printable, render_cached};
 
 use super::app::App;
-use super::overlay::{blank, draw_help, printable, put_line, put_text};
+use super::overlay::{blank, draw_help, put_line, put_text};
 
 /// Smallest terminal drawn: below this a short message replaces the frame.
 pub const MIN_COLS: u16 = 10;
@@ -162,7 +162,9 @@ impl Screen {
         out
     }
 
-    /// The status line: stage, camera, light, costs of the last frame, colour mode, scene.
+    /// The status line: scene (first, so a narrow terminal still shows it), stage, camera,
+    /// light, costs of the last frame, colour mode. The scene's name comes from a file: its
+    /// control characters are removed.
     fn status(&self, app: &App) -> String {
         let key = Stage::ALL.iter().position(|&s| s == app.stage).unwrap_or(0) + 1;
         let spp = if app.stage == Stage::Gi {
@@ -172,7 +174,8 @@ impl Screen {
         };
         let light = app.light().map_or_else(|| "none".into(), xyz);
         format!(
-            " {key}:{}{spp}  cam {} {}°  light {light}  render {:.1}ms encode {:.1}ms {}B  {}  {}  H:help",
+            " {}  {key}:{}{spp}  cam {} {}°  light {light}  render {:.1}ms encode {:.1}ms {}B  {}  H:help",
+            printable(&app.scene.name),
             app.stage.name(),
             xyz(app.camera.position),
             fixed(app.camera.yaw.to_degrees(), 0),
@@ -180,7 +183,6 @@ impl Screen {
             ms(self.stats.encode),
             self.stats.bytes,
             app.color.name(),
-            printable(&app.scene.name),
         )
     }
 }
@@ -278,5 +280,31 @@ mod tests {
             let out = s.draw(&a);
             assert_eq!(out.is_empty(), c == 0 || r == 0, "{c}x{r}");
         }
+    }
+
+    #[test]
+    fn the_status_line_starts_with_the_scene_name_without_control_characters() {
+        let source = "name = \"evil\\u001b[2J\\u0007box\"\n[material.m]\ncolour = [1, 1, 1]\n[[object]]\nkind = \"box\"\nmaterial = \"m\"\ncentre = [0, 0, 0]\nsize = [1, 1, 1]\n";
+        let scene =
+            raytty::scenefile::parse(source, "t.toml", "t", &raytty::scenefile::no_meshes).unwrap();
+        let a = App::new(scene, ColorMode::Ascii, (40, 5));
+        let mut s = Screen::new();
+        assert!(
+            s.status(&a).starts_with(" evil[2Jbox  5:indirect"),
+            "{}",
+            s.status(&a)
+        );
+        s.render(&a);
+        let bytes = s.draw(&a);
+        assert!(
+            !bytes.windows(4).any(|w| w == b"\x1b[2J"),
+            "the name's escape reached the terminal"
+        );
+        assert!(!bytes.contains(&0x07));
+        let shown = String::from_utf8_lossy(&bytes);
+        assert!(
+            shown.contains("evil[2Jbox"),
+            "the scene's name is not shown"
+        );
     }
 }

@@ -1,0 +1,70 @@
+//! `--scene PATH|NAME`: a scene file if the path exists or ends in `.toml`, else a built-in
+//! scene's name. Every failure is a [`UsageError`] (exit status 2) that says what would work.
+
+use std::path::Path;
+
+use anyhow::{Result, bail};
+use raytty::builtin::{self, BUILTINS};
+use raytty::{Scene, printable, scenefile};
+
+use crate::cli::UsageError;
+
+/// The scene `arg` names; the Cornell box when there is none.
+pub fn load_scene(arg: Option<&str>) -> Result<Scene> {
+    let Some(arg) = arg else {
+        return Ok(raytty::cornell_box());
+    };
+    let path = Path::new(arg);
+    if path.exists() || arg.ends_with(".toml") {
+        return scenefile::load(path).map_err(|e| UsageError(e.to_string()).into());
+    }
+    match builtin::find(arg) {
+        Some(b) => b.load().map_err(|e| UsageError(e.to_string()).into()),
+        None => bail!(UsageError(format!(
+            "--scene {}: no such file and no built-in scene of that name{}; built-in scenes: {} (or give a path to a .toml scene file)",
+            printable(arg),
+            scenefile::did_you_mean(arg, &builtin::names()),
+            builtin::names().join(", ")
+        ))),
+    }
+}
+
+/// `raytty scenes`: the built-in scenes, one a line, with their triangle counts.
+pub fn list() -> String {
+    let width = BUILTINS.iter().map(|b| b.name.len()).max().unwrap_or(0);
+    let mut out = String::new();
+    for b in &BUILTINS {
+        out += &format!(
+            "{:<width$}  {:>9} triangles  {}\n",
+            b.name,
+            group_thousands(b.triangles),
+            b.description
+        );
+    }
+    out
+}
+
+/// 1003530 → "1,003,530".
+fn group_thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thousands_are_grouped() {
+        assert_eq!(group_thousands(30), "30");
+        assert_eq!(group_thousands(1_003_530), "1,003,530");
+        assert_eq!(group_thousands(100_000), "100,000");
+    }
+}

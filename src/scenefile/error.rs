@@ -1,0 +1,149 @@
+//! What a user gets for a mistake in a scene file or a mesh: the file, the line and column, what
+//! was wrong and what would be right. Positions come from byte offsets into the source.
+
+use std::fmt;
+
+use crate::frame::printable;
+
+/// A mistake in a scene file or in a mesh it names.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SceneFileError {
+    /// The file the mistake is in, as the user named it (control characters removed).
+    pub file: String,
+    /// 1-based line; 0 when the mistake is about the file as a whole (it cannot be read).
+    pub line: usize,
+    /// 1-based column in characters; 0 with `line` 0.
+    pub column: usize,
+    /// What was wrong and what would be right (control characters removed).
+    pub message: String,
+}
+
+impl SceneFileError {
+    /// An error at byte `offset` of `source` (clamped to its length).
+    pub fn at(file: &str, source: &str, offset: usize, message: impl Into<String>) -> Self {
+        let (line, column) = line_column(source, offset);
+        SceneFileError {
+            file: printable(file),
+            line,
+            column,
+            message: printable(&message.into()),
+        }
+    }
+
+    /// An error about a whole file (no position), such as one that cannot be read.
+    pub fn whole_file(file: &str, message: impl Into<String>) -> Self {
+        SceneFileError {
+            file: printable(file),
+            line: 0,
+            column: 0,
+            message: printable(&message.into()),
+        }
+    }
+}
+
+impl fmt::Display for SceneFileError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.line == 0 {
+            write!(f, "{}: {}", self.file, self.message)
+        } else {
+            write!(
+                f,
+                "{}:{}:{}: {}",
+                self.file, self.line, self.column, self.message
+            )
+        }
+    }
+}
+
+impl std::error::Error for SceneFileError {}
+
+/// The 1-based line and column (in characters) of byte `offset` in `source`.
+pub fn line_column(source: &str, offset: usize) -> (usize, usize) {
+    let mut offset = offset.min(source.len());
+    while !source.is_char_boundary(offset) {
+        offset -= 1;
+    }
+    let before = &source[..offset];
+    let line = before.bytes().filter(|&b| b == b'\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    (line, before[line_start..].chars().count() + 1)
+}
+
+/// The edit distance between `a` and `b` (insertions, deletions, substitutions and swaps of
+/// two neighbours each cost 1).
+pub fn edit_distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
+    let b: Vec<char> = b.chars().collect();
+    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in d[0].iter_mut().enumerate() {
+        *cell = j;
+    }
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut best = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                best = best.min(d[i - 2][j - 2] + 1);
+            }
+            d[i][j] = best;
+        }
+    }
+    d[a.len()][b.len()]
+}
+
+/// The known name closest to `word`, if it is close enough to be a likely typo: at most 2 edits,
+/// and fewer than half of the word's characters.
+pub fn suggest<'a>(word: &str, known: &[&'a str]) -> Option<&'a str> {
+    // Typos longer than this are not worth comparing (and keep the quadratic distance cheap).
+    const LONGEST: usize = 64;
+    if word.chars().count() > LONGEST {
+        return None;
+    }
+    let limit = 2.min(word.chars().count().div_ceil(2));
+    known
+        .iter()
+        .map(|k| (edit_distance(&word.to_lowercase(), k), *k))
+        .filter(|&(d, _)| d <= limit)
+        .min_by_key(|&(d, _)| d)
+        .map(|(_, k)| k)
+}
+
+/// " did you mean `x`?" when `word` is close to one of `known`, else "".
+pub fn did_you_mean(word: &str, known: &[&str]) -> String {
+    match suggest(word, known) {
+        Some(k) => format!("; did you mean `{k}`?"),
+        None => String::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn positions_are_one_based_and_count_characters() {
+        let s = "a = 1\nbé = 2\n";
+        assert_eq!(line_column(s, 0), (1, 1));
+        assert_eq!(line_column(s, 6), (2, 1));
+        assert_eq!(line_column(s, s.find('=').unwrap()), (1, 3));
+        let second = s.rfind('=').unwrap();
+        assert_eq!(line_column(s, second), (2, 4));
+        assert_eq!(line_column(s, 10_000), (3, 1));
+    }
+
+    #[test]
+    fn close_typos_get_a_suggestion_and_far_ones_none() {
+        let known = ["colour", "mirror"];
+        assert_eq!(suggest("color", &known), Some("colour"));
+        assert_eq!(suggest("mirorr", &known), Some("mirror"));
+        assert_eq!(suggest("Colour", &known), Some("colour"));
+        assert_eq!(suggest("size", &known), None);
+        assert_eq!(suggest("m", &known), None);
+        assert_eq!(edit_distance("ab", "ba"), 1);
+    }
+}

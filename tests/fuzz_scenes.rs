@@ -1,0 +1,290 @@
+//! A seeded mutation fuzzer over valid scene files and OBJ meshes: byte flips, insertions and
+//! deletions, token swaps, numbers replaced by NaN, infinities, -0, 1e39 and huge integers,
+//! truncation, duplicated lines, and the same for the mesh. Every input must either load into
+//! a scene that renders a finite frame, or fail with an error that has a line and column. No
+//! input may panic, and none is larger than [`MAX_INPUT`] bytes, so none can take long.
+//!
+//! `cargo test` runs the regression corpus in `tests/fuzz_corpus/` (inputs the fuzzer once
+//! found interesting) and a short run; the long run is ignored:
+//!
+//!     RAYTTY_FUZZ_ITERATIONS=200000 RAYTTY_FUZZ_SEED=1 cargo test --test fuzz_scenes -- --ignored
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use raytty::builtin::BUILTINS;
+use raytty::rng::Rng;
+use raytty::scenefile::{self, SceneFileError};
+use raytty::{Stage, render};
+
+/// Largest mutated input: far above the seed files, small enough that every input is quick.
+const MAX_INPUT: usize = 64 * 1024;
+
+/// The name the mutated mesh is read under.
+const MESH: &str = "mesh.obj";
+
+/// Valid files to start from: the built-ins (the big sphere made small), the example, and a
+/// scene that reads a mesh.
+fn seeds() -> Vec<String> {
+    let mut s: Vec<String> = BUILTINS
+        .iter()
+        .map(|b| b.source.replace("subdivisions = 224", "subdivisions = 6"))
+        .collect();
+    s.push(
+        include_str!("../scenes/example.toml")
+            .replace("path = \"tetrahedron.obj\"", "path = \"mesh.obj\""),
+    );
+    s.push(
+        "name = \"m\"\n[camera]\nposition = [0, -0.5, -3]\npitch = 10\n[[light]]\nposition = [0, -2, -1]\npower = [10, 12, 14]\n[material.a]\ncolour = [0.5, 0.6, 0.7]\nmirror = 0.25\n[[object]]\nkind = \"obj\"\nmaterial = \"a\"\npath = \"mesh.obj\"\nscale = [1, 2, 1]\nrotate_y = -45\n[effects]\nindirect = { bounces = 2 }\nsamples = 2\n".to_string(),
+    );
+    s
+}
+
+const MESH_SEED: &str = include_str!("../scenes/tetrahedron.obj");
+
+/// Replacement numbers: the values that break parsers and arithmetic.
+const NUMBERS: [&str; 16] = [
+    "nan",
+    "-nan",
+    "inf",
+    "-inf",
+    "1e39",
+    "-1e39",
+    "-0",
+    "-0.0",
+    "0",
+    "-1",
+    "1e6",
+    "1e-45",
+    "18446744073709551616",
+    "9223372036854775807",
+    "-9223372036854775808",
+    "3.4028236e38",
+];
+
+/// Characters a byte insertion draws from: TOML and OBJ punctuation, digits, and a few hostile ones.
+const BYTES: &[u8] = b"[]{}=,.\"'#\n\r\t -+/0123456789eEfvnaix\x00\x1b\x7f\\";
+
+fn mutate(rng: &mut Rng, input: &str) -> String {
+    let mut b = input.as_bytes().to_vec();
+    let pick = |rng: &mut Rng, n: usize| (rng.next_u64() % n.max(1) as u64) as usize;
+    for _ in 0..1 + pick(rng, 3) {
+        match pick(rng, 9) {
+            0 if !b.is_empty() => {
+                let i = pick(rng, b.len());
+                b[i] ^= 1 << pick(rng, 8);
+            }
+            1 => {
+                let i = pick(rng, b.len() + 1);
+                b.insert(i, BYTES[pick(rng, BYTES.len())]);
+            }
+            2 if !b.is_empty() => {
+                let i = pick(rng, b.len());
+                let n = 1 + pick(rng, 16);
+                b.drain(i..(i + n).min(b.len()));
+            }
+            3 => b.truncate(pick(rng, b.len() + 1)),
+            4 | 5 => {
+                // Replace a number with a hostile one.
+                let text = String::from_utf8_lossy(&b).into_owned();
+                let spans = numbers(&text);
+                if !spans.is_empty() {
+                    let (s, e) = spans[pick(rng, spans.len())];
+                    let mut t = text;
+                    t.replace_range(s..e, NUMBERS[pick(rng, NUMBERS.len())]);
+                    b = t.into_bytes();
+                }
+            }
+            6 => {
+                // Swap two whitespace-separated tokens.
+                let text = String::from_utf8_lossy(&b).into_owned();
+                let mut tokens: Vec<&str> = text.split(' ').collect();
+                if tokens.len() > 1 {
+                    let (i, j) = (pick(rng, tokens.len()), pick(rng, tokens.len()));
+                    tokens.swap(i, j);
+                }
+                b = tokens.join(" ").into_bytes();
+            }
+            7 => {
+                // Duplicate a line.
+                let text = String::from_utf8_lossy(&b).into_owned();
+                let mut lines: Vec<&str> = text.split('\n').collect();
+                let i = pick(rng, lines.len());
+                lines.insert(i, lines[i]);
+                b = lines.join("\n").into_bytes();
+            }
+            _ => {
+                // Copy a random slice somewhere else.
+                if !b.is_empty() {
+                    let s = pick(rng, b.len());
+                    let e = (s + 1 + pick(rng, 64)).min(b.len());
+                    let chunk = b[s..e].to_vec();
+                    let at = pick(rng, b.len());
+                    b.splice(at..at, chunk);
+                }
+            }
+        }
+    }
+    b.truncate(MAX_INPUT);
+    String::from_utf8_lossy(&b).into_owned()
+}
+
+/// Byte ranges of the numbers in `text`.
+fn numbers(text: &str) -> Vec<(usize, usize)> {
+    let bytes = text.as_bytes();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i].is_ascii_digit() {
+            let s = if i > 0 && bytes[i - 1] == b'-' {
+                i - 1
+            } else {
+                i
+            };
+            while i < bytes.len() && (bytes[i].is_ascii_digit() || b".eE".contains(&bytes[i])) {
+                i += 1;
+            }
+            out.push((s, i));
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+/// What one input did.
+#[derive(Debug, Default)]
+struct Tally {
+    inputs: u64,
+    loaded: u64,
+    errors: u64,
+    slowest: Duration,
+}
+
+/// Loads `scene` (with `mesh` as the mesh file) and checks the outcome; panics on a finding.
+fn check(scene: &str, mesh: &[u8], tally: &mut Tally) {
+    let start = Instant::now();
+    let read = |p: &str| {
+        if p == MESH {
+            Ok((MESH.to_string(), mesh.to_vec()))
+        } else {
+            Err(format!("cannot read {p}: no such file"))
+        }
+    };
+    let outcome = catch_unwind(AssertUnwindSafe(|| {
+        let result = scenefile::parse(scene, "fuzz.toml", "fuzz", &read);
+        if let Ok(s) = &result {
+            // A scene that loaded renders a finite frame (samples capped to keep it quick).
+            let mut settings = Stage::Indirect.settings(s.effects);
+            settings.effects.samples = settings.effects.samples.min(2);
+            let frame = render(s, &s.camera, &s.lights, &settings, 6, 4);
+            assert!(frame.image.pixels.iter().all(|p| p.is_finite()));
+        }
+        result
+    }));
+    let result = outcome.unwrap_or_else(|_| {
+        panic!(
+            "panic on input:\n{scene:?}\nmesh:\n{:?}",
+            String::from_utf8_lossy(mesh)
+        )
+    });
+    match result {
+        Ok(_) => tally.loaded += 1,
+        Err(e) => {
+            tally.errors += 1;
+            positioned(&e, scene);
+        }
+    }
+    tally.inputs += 1;
+    tally.slowest = tally.slowest.max(start.elapsed());
+}
+
+/// An error has a line and a column, a message, and no control characters.
+fn positioned(e: &SceneFileError, input: &str) {
+    assert!(
+        e.line >= 1 && e.column >= 1 && !e.message.is_empty(),
+        "error without a position: {e}\ninput: {input:?}"
+    );
+    let shown = e.to_string();
+    assert!(!shown.chars().any(char::is_control), "{shown:?}");
+    assert!(shown.starts_with(&format!("{}:{}:{}: ", e.file, e.line, e.column)));
+}
+
+fn run(iterations: u64, seed: u64) -> Tally {
+    let seeds = seeds();
+    let mut rng = Rng::seeded(seed);
+    let mut tally = Tally::default();
+    for i in 0..iterations {
+        let base = &seeds[(i % seeds.len() as u64) as usize];
+        // Mostly mutate the scene; sometimes the mesh; sometimes both.
+        let (scene, mesh) = match rng.next_u64() % 4 {
+            0 => (base.clone(), mutate(&mut rng, MESH_SEED)),
+            1 => (mutate(&mut rng, base), mutate(&mut rng, MESH_SEED)),
+            _ => (mutate(&mut rng, base), MESH_SEED.to_string()),
+        };
+        check(&scene, mesh.as_bytes(), &mut tally);
+    }
+    tally
+}
+
+#[test]
+fn every_seed_loads() {
+    for (i, s) in seeds().iter().enumerate() {
+        let read = |_: &str| Ok((MESH.to_string(), MESH_SEED.as_bytes().to_vec()));
+        scenefile::parse(s, "seed.toml", "seed", &read).unwrap_or_else(|e| panic!("seed {i}: {e}"));
+    }
+}
+
+#[test]
+fn regression_corpus() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_corpus");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            n += 1;
+            let source = String::from_utf8_lossy(&std::fs::read(&path).unwrap()).into_owned();
+            let outcome = catch_unwind(|| scenefile::load(&path));
+            match outcome.unwrap_or_else(|_| panic!("{} panics", path.display())) {
+                Ok(_) => {}
+                Err(e) => positioned(&e, &source),
+            }
+        }
+    }
+    assert!(n >= 5, "the corpus has {n} files");
+}
+
+/// A short run in every `cargo test`: a few hundred inputs, well under a second.
+#[test]
+fn short_run() {
+    let t = run(300, 7);
+    assert_eq!(t.inputs, 300);
+    assert!(t.loaded > 0 && t.errors > 0, "{t:?}");
+}
+
+/// The long run: `RAYTTY_FUZZ_ITERATIONS` inputs (default 20000) from `RAYTTY_FUZZ_SEED`.
+#[test]
+#[ignore]
+fn long_run() {
+    let var = |name: &str, default: u64| {
+        std::env::var(name)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(default)
+    };
+    let (n, seed) = (
+        var("RAYTTY_FUZZ_ITERATIONS", 20_000),
+        var("RAYTTY_FUZZ_SEED", 1),
+    );
+    let start = Instant::now();
+    let t = run(n, seed);
+    eprintln!(
+        "fuzz: {} inputs from seed {seed} in {:.1?}: {} loaded, {} rejected with a position; slowest input {:.1?}",
+        t.inputs,
+        start.elapsed(),
+        t.loaded,
+        t.errors,
+        t.slowest
+    );
+}
