@@ -1,5 +1,5 @@
 //! A bounding volume hierarchy over a scene's triangles: binned SAH, built in parallel
-//! ([`build`]), stored as 32-byte nodes in sibling pairs (one 64-byte cache line, boxes laid out
+//! (`bvh/build.rs`), stored as 32-byte nodes in sibling pairs (one 64-byte cache line, boxes laid out
 //! slab by slab so both children are tested at once) in depth-first order, traversed
 //! iteratively with a fixed stack.
 //!
@@ -29,7 +29,7 @@ use crate::geometry::{Ray, Triangle, gamma, intersect_watertight, next_float_up}
 
 pub use build::{LEAF_MAX, SAH_BINS};
 
-/// Most levels a hierarchy has (root = level 1); [`build`] keeps to it by switching from SAH to
+/// Most levels a hierarchy has (root = level 1); the builder keeps to it by switching from SAH to
 /// median splits deep down, so traversal can use a fixed stack.
 pub const MAX_DEPTH: usize = 64;
 
