@@ -7,7 +7,9 @@
 //! builder would reject (degenerate triangles, bad lights) is caught first, here, with a line.
 
 mod build;
+mod check;
 mod error;
+mod objects;
 mod spec;
 
 use std::io::Read;
