@@ -4,8 +4,9 @@
 //! a scene that renders a finite frame, or fail with an error that has a line and column. No
 //! input may panic, and none is larger than [`MAX_INPUT`] bytes, so none can take long.
 //!
-//! `cargo test` runs the regression corpus in `tests/fuzz_corpus/` (inputs the fuzzer once
-//! found interesting) and a short run; the long run is ignored:
+//! `cargo test` runs the regression corpus in `tests/fuzz_corpus/` (hostile inputs: files
+//! named `ok_*.toml` must load, every other `.toml` must be refused with a position) and a
+//! short run; the long run is ignored:
 //!
 //!     RAYTTY_FUZZ_ITERATIONS=200000 RAYTTY_FUZZ_SEED=1 cargo test --test fuzz_scenes -- --ignored
 
@@ -246,9 +247,17 @@ fn regression_corpus() {
             n += 1;
             let source = String::from_utf8_lossy(&std::fs::read(&path).unwrap()).into_owned();
             let outcome = catch_unwind(|| scenefile::load(&path));
+            let must_load = path
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("ok_");
             match outcome.unwrap_or_else(|_| panic!("{} panics", path.display())) {
-                Ok(_) => {}
-                Err(e) => positioned(&e, &source),
+                Ok(_) => assert!(must_load, "{} loads", path.display()),
+                Err(e) => {
+                    assert!(!must_load, "{}: {e}", path.display());
+                    positioned(&e, &source);
+                }
             }
         }
     }

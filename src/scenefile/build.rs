@@ -65,7 +65,7 @@ pub fn build(
     let mut materials: HashMap<&str, Material> = HashMap::new();
     for (key, m) in &spec.material {
         let m = m.get_ref();
-        for c in m.colour.get_ref() {
+        for c in &m.colour.get_ref().0 {
             if !(*c >= 0.0 && *c <= 1.0) {
                 return Err(cx.err_at(
                     &m.colour,
@@ -85,7 +85,7 @@ pub fn build(
         materials.insert(
             key.as_str(),
             Material {
-                colour: Vec3::from(m.colour.get_ref().map(|c| c as f32)),
+                colour: Vec3::from(m.colour.get_ref().0.map(|c| c as f32)),
                 mirror: mirror as f32,
             },
         );

@@ -6,6 +6,7 @@ use toml::Spanned;
 
 use super::MAX_COORDINATE;
 use super::error::{SceneFileError, did_you_mean};
+use super::spec::Three;
 
 /// How each required key is written, for "missing key" messages.
 const KEY_FORMS: [(&str, &str); 6] = [
@@ -40,8 +41,8 @@ impl Ctx<'_> {
     }
 
     /// `v` as an `f32` triple, each component finite and within ±[`MAX_COORDINATE`].
-    pub fn point(&self, v: &Spanned<[f64; 3]>, what: &str) -> Result<Vec3, SceneFileError> {
-        for c in v.get_ref() {
+    pub fn point(&self, v: &Spanned<Three<f64>>, what: &str) -> Result<Vec3, SceneFileError> {
+        for c in &v.get_ref().0 {
             if !c.is_finite() || c.abs() > MAX_COORDINATE {
                 return Err(self.err_at(
                     v,
@@ -51,7 +52,7 @@ impl Ctx<'_> {
                 ));
             }
         }
-        Ok(Vec3::from(v.get_ref().map(|c| c as f32)))
+        Ok(Vec3::from(v.get_ref().0.map(|c| c as f32)))
     }
 
     /// A number in `lo..=hi`.
@@ -138,6 +139,16 @@ pub fn toml_error(cx: &Ctx, e: &toml::de::Error) -> SceneFileError {
             .replace("expected i64", "expected a whole number")
             .replace("expected f64", "expected a number")
             .replace("expected a boolean", "expected true or false")
+            .replace("invalid type: map", "invalid type: table")
+            .replace("invalid type: sequence", "invalid type: array")
+            .replace(
+                "expected a sequence",
+                "expected an array: [a, b, ...], or [[NAME]] tables (double brackets) for a list of tables",
+            )
+            .replace(
+                "expected a map",
+                "expected a table: [NAME] or [NAME.KEY] headers, or { key = value }",
+            )
     };
     cx.err(offset, message)
 }

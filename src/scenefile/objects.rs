@@ -148,7 +148,7 @@ fn listed(
     let mut out = Vec::with_capacity(list.len());
     for t in list {
         let mut v = [Vec3::ZERO; 3];
-        for (vi, p) in v.iter_mut().zip(t.get_ref()) {
+        for (vi, p) in v.iter_mut().zip(&t.get_ref().0) {
             *vi = cx.point(&Spanned::new(t.span(), *p), "a triangle vertex")?;
         }
         out.push(v);
