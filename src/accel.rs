@@ -1,12 +1,22 @@
 //! Acceleration structure: which triangles a ray needs to be tested against.
 //!
-//! The scene's triangles are grouped into objects (the Cornell room, each block, a mesh), each
-//! with a bounding box; a ray is tested only against the triangles of the objects whose box it
-//! meets. Closest-hit queries shrink `t_max` as they go; shadow queries stop at the first hit.
+//! Two kinds, chosen by triangle count ([`AccelKind::for_triangles`]):
+//!
+//! - [`AccelKind::Flat`]: the scene's objects (the Cornell room, each block, a mesh), each with
+//!   a bounding box; a ray is tested against the triangles of every object whose box it meets.
+//!   Fastest for a few dozen triangles.
+//! - [`AccelKind::Bvh`]: a bounding volume hierarchy ([`crate::bvh`]).
+//!
+//! Both answer exactly as testing every triangle would: the closest hit is the one with the
+//! smallest `t`, ties going to the lowest triangle index, and a shadow ray is occluded when any
+//! triangle has a hit before `t_max`. So a frame is byte-identical whichever is used (see
+//! [`crate::bvh`] for how culling keeps to that).
 
 use std::ops::Range;
+use std::time::{Duration, Instant};
 
-use crate::geometry::{Aabb, Ray, Triangle};
+use crate::bvh::{Bvh, cull_bound, shrunk_t_max};
+use crate::geometry::{Aabb, Ray, Triangle, intersect_watertight};
 
 /// A closest hit in a scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -19,57 +29,202 @@ pub struct Hit {
     pub triangle: u32,
 }
 
-/// Objects (contiguous triangle ranges) with their bounding boxes.
-#[derive(Clone, Debug, Default)]
+/// Scenes with at least this many triangles get a BVH; smaller ones the flat object list.
+///
+/// Measured with `cargo run --release --example accel_bench`: on the 30-triangle Cornell box
+/// (7 objects) the flat list and the BVH trace at about the same rate (see `notes/accel.md`);
+/// past a few dozen triangles per object the BVH wins and the gap grows with the count.
+pub const BVH_THRESHOLD: usize = 64;
+
+/// Which acceleration structure a scene uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum AccelKind {
+    /// The scene's objects with their bounding boxes, each tested triangle by triangle.
+    Flat,
+    /// A bounding volume hierarchy over all triangles.
+    Bvh,
+}
+
+impl AccelKind {
+    /// The faster kind for a scene of `triangles` triangles (see [`BVH_THRESHOLD`]).
+    pub fn for_triangles(triangles: usize) -> AccelKind {
+        if triangles >= BVH_THRESHOLD {
+            AccelKind::Bvh
+        } else {
+            AccelKind::Flat
+        }
+    }
+
+    /// A short lower-case name ("flat", "bvh").
+    pub fn name(self) -> &'static str {
+        match self {
+            AccelKind::Flat => "flat",
+            AccelKind::Bvh => "bvh",
+        }
+    }
+}
+
+/// What an acceleration structure holds and what it cost to build.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AccelStats {
+    /// Which kind it is.
+    pub kind: AccelKind,
+    /// Triangles it holds.
+    pub triangles: usize,
+    /// Boxes: BVH nodes, or the flat list's objects.
+    pub nodes: usize,
+    /// Levels of boxes above the triangles (1 for the flat list, 0 when empty).
+    pub depth: u32,
+    /// Wall-clock build time.
+    pub build: Duration,
+}
+
+/// A scene's acceleration structure.
+#[derive(Clone)]
 pub struct Accel {
-    objects: Vec<(Aabb, Range<usize>)>,
+    structure: Structure,
+    stats: AccelStats,
+}
+
+/// Shows the structure but not its build time, so that two builds of one scene print the same.
+impl std::fmt::Debug for Accel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Accel")
+            .field("structure", &self.structure)
+            .finish_non_exhaustive()
+    }
+}
+
+#[derive(Clone, Debug)]
+enum Structure {
+    Flat(Vec<(Aabb, Range<usize>)>),
+    Bvh(Bvh),
+}
+
+impl Default for Accel {
+    fn default() -> Accel {
+        Accel::build_kind(&[], &[], AccelKind::Flat)
+    }
 }
 
 impl Accel {
-    /// Builds the structure over `triangles`, one object per range in `objects`.
+    /// Builds the faster kind for the triangle count ([`AccelKind::for_triangles`]).
     pub fn build(triangles: &[Triangle], objects: &[Range<usize>]) -> Accel {
-        let objects = objects
-            .iter()
-            .filter(|r| !r.is_empty())
-            .map(|r| {
-                let aabb = triangles[r.clone()]
-                    .iter()
-                    .fold(Aabb::EMPTY, |b, t| b.union(Aabb::of_triangle(t)));
-                (aabb, r.clone())
-            })
-            .collect();
-        Accel { objects }
+        Accel::build_kind(
+            triangles,
+            objects,
+            AccelKind::for_triangles(triangles.len()),
+        )
     }
 
-    /// The closest hit with `t < t_max`, or `None`.
+    /// Builds a structure of the given kind over `triangles`; `objects` are the flat list's
+    /// groups (contiguous ranges of `triangles`).
+    pub fn build_kind(triangles: &[Triangle], objects: &[Range<usize>], kind: AccelKind) -> Accel {
+        let start = Instant::now();
+        let structure = match kind {
+            AccelKind::Flat => Structure::Flat(
+                objects
+                    .iter()
+                    .filter(|r| !r.is_empty())
+                    .map(|r| {
+                        let aabb = triangles[r.clone()]
+                            .iter()
+                            .fold(Aabb::EMPTY, |b, t| b.union(Aabb::of_triangle(t)));
+                        (aabb, r.clone())
+                    })
+                    .collect(),
+            ),
+            AccelKind::Bvh => Structure::Bvh(Bvh::build(triangles)),
+        };
+        let build = start.elapsed();
+        let (nodes, depth) = match &structure {
+            Structure::Flat(objects) => (objects.len(), u32::from(!objects.is_empty())),
+            Structure::Bvh(bvh) => (bvh.nodes(), bvh.depth()),
+        };
+        Accel {
+            structure,
+            stats: AccelStats {
+                kind,
+                triangles: triangles.len(),
+                nodes,
+                depth,
+                build,
+            },
+        }
+    }
+
+    /// Its kind.
+    pub fn kind(&self) -> AccelKind {
+        self.stats.kind
+    }
+
+    /// What it holds and what it cost to build.
+    pub fn stats(&self) -> AccelStats {
+        self.stats
+    }
+
+    /// The closest hit with `t < t_max` (ties go to the lowest triangle index), or `None`.
+    /// `triangles` must be the list the structure was built over.
+    #[inline]
     pub fn intersect(&self, triangles: &[Triangle], ray: &Ray, t_max: f32) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        let mut t_max = t_max;
-        for (aabb, range) in &self.objects {
-            if !aabb.hit(ray, t_max) {
+        match &self.structure {
+            Structure::Flat(objects) => flat_intersect(objects, triangles, ray, t_max),
+            Structure::Bvh(bvh) => bvh.intersect(ray, t_max),
+        }
+    }
+
+    /// Whether any triangle has a hit with `t < t_max` (stops at the first).
+    #[inline]
+    pub fn occluded(&self, triangles: &[Triangle], ray: &Ray, t_max: f32) -> bool {
+        match &self.structure {
+            Structure::Flat(objects) => flat_occluded(objects, triangles, ray, t_max),
+            Structure::Bvh(bvh) => bvh.occluded(ray, t_max),
+        }
+    }
+}
+
+fn flat_intersect(
+    objects: &[(Aabb, Range<usize>)],
+    triangles: &[Triangle],
+    ray: &Ray,
+    t_max: f32,
+) -> Option<Hit> {
+    let mut best: Option<Hit> = None;
+    let mut tri_t_max = t_max;
+    let mut bound = cull_bound(t_max);
+    for (aabb, range) in objects {
+        if !aabb.hit(ray, bound) {
+            continue;
+        }
+        for i in range.clone() {
+            let Some(h) = intersect_watertight(ray, &triangles[i].v, tri_t_max) else {
                 continue;
-            }
-            for i in range.clone() {
-                if let Some(h) = triangles[i].intersect(ray, t_max) {
-                    t_max = h.t;
-                    best = Some(Hit {
-                        t: h.t,
-                        b: h.b,
-                        triangle: i as u32,
-                    });
-                }
+            };
+            if best.is_none_or(|b| h.t < b.t || h.t == b.t && (i as u32) < b.triangle) {
+                best = Some(Hit {
+                    t: h.t,
+                    b: h.b,
+                    triangle: i as u32,
+                });
+                tri_t_max = shrunk_t_max(h.t, t_max);
+                bound = cull_bound(h.t);
             }
         }
-        best
     }
+    best
+}
 
-    /// Whether anything lies along the ray for `t < t_max` (any hit; stops at the first).
-    pub fn occluded(&self, triangles: &[Triangle], ray: &Ray, t_max: f32) -> bool {
-        self.objects.iter().any(|(aabb, range)| {
-            aabb.hit(ray, t_max)
-                && triangles[range.clone()]
-                    .iter()
-                    .any(|t| t.intersect(ray, t_max).is_some())
-        })
-    }
+fn flat_occluded(
+    objects: &[(Aabb, Range<usize>)],
+    triangles: &[Triangle],
+    ray: &Ray,
+    t_max: f32,
+) -> bool {
+    let bound = cull_bound(t_max);
+    objects.iter().any(|(aabb, range)| {
+        aabb.hit(ray, bound)
+            && triangles[range.clone()]
+                .iter()
+                .any(|t| intersect_watertight(ray, &t.v, t_max).is_some())
+    })
 }

@@ -65,8 +65,43 @@ fn resolve_color(choice: ColorChoice, no_color: bool, colorterm: Option<&str>) -
 enum Command {
     /// Render one frame to stdout or a file (text frames or images).
     Render(RenderArgs),
+    /// Measure what each step of accuracy costs: time per frame against error from a cached
+    /// path-traced reference (a Markdown table, or CSV; an SVG plot; the README's table).
+    Bench(BenchArgs),
     /// List the built-in scenes with their triangle counts.
     Scenes,
+}
+
+/// Options of `raytty bench`.
+#[derive(Args, Debug)]
+struct BenchArgs {
+    /// Image sizes in pixels, comma-separated (default 500x500,200x100).
+    #[arg(long, value_name = "WxH,...", value_parser = parse_size, value_delimiter = ',')]
+    sizes: Vec<(u32, u32)>,
+    /// Timed runs per row, after a warm-up (default 5).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    runs: Option<u32>,
+    /// GI rows go 1, 4, 16, … samples per pixel up to this (default 64).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    max_spp: Option<u32>,
+    /// The reference's samples per pixel (default 1024).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    ref_spp: Option<u32>,
+    /// The reference's maximum bounces (default 16).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    ref_bounces: Option<u32>,
+    /// Print CSV instead of the Markdown table.
+    #[arg(long)]
+    csv: bool,
+    /// Write the error-against-time plot (log axes) to PATH as SVG.
+    #[arg(long, value_name = "PATH")]
+    svg: Option<PathBuf>,
+    /// Rewrite the table between <!-- bench:start --> and <!-- bench:end --> in PATH.
+    #[arg(long, value_name = "PATH")]
+    readme: Option<PathBuf>,
+    /// Tiny sizes, 2 runs, a small reference: seconds, for tests.
+    #[arg(long)]
+    quick: bool,
 }
 
 /// Output formats of `raytty render`.
@@ -188,6 +223,7 @@ pub fn main() -> ExitCode {
             .write_all(crate::scene_arg::list().as_bytes())
             .map(|()| ExitCode::SUCCESS)
             .map_err(Into::into),
+        Some(Command::Bench(a)) => run_bench(a, cli.scene.as_deref()).map(|()| ExitCode::SUCCESS),
         None => run_default(color, cli.scene.as_deref()),
     };
     match result {
@@ -202,6 +238,57 @@ pub fn main() -> ExitCode {
             })
         }
     }
+}
+
+/// `raytty bench`: with no `--scene`, the accuracy price list of the Cornell box; with
+/// `--scene`, what that scene costs (load and acceleration build, frame times, M rays/s).
+fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
+    if let Some(name) = scene {
+        let start = std::time::Instant::now();
+        let scene = crate::scene_arg::load_scene(Some(name))?;
+        let load = start.elapsed();
+        let sizes = if a.sizes.is_empty() {
+            vec![(200, 100), (500, 500)]
+        } else {
+            a.sizes
+        };
+        let runs = a.runs.unwrap_or(if a.quick { 2 } else { 5 });
+        let report = raytty::scene_bench::bench_scene(&scene, &sizes, runs);
+        let mut out = io::stdout().lock();
+        writeln!(
+            out,
+            "Scene `{}` loaded in {:.0} ms (parse, generate, validate, build).\n",
+            raytty::printable(name),
+            load.as_secs_f64() * 1e3
+        )?;
+        out.write_all(report.to_markdown().as_bytes())?;
+        return Ok(());
+    }
+    let request = raytty::bench::BenchRequest {
+        quick: a.quick,
+        sizes: a.sizes,
+        runs: a.runs,
+        max_spp: a.max_spp,
+        ref_spp: a.ref_spp,
+        ref_bounces: a.ref_bounces,
+        csv: a.csv,
+        svg: a.svg,
+        readme: a.readme,
+        command: std::iter::once("raytty".to_string())
+            .chain(std::env::args().skip(1))
+            .collect::<Vec<_>>()
+            .join(" "),
+    };
+    raytty::bench::run_command(
+        &raytty::cornell_box(),
+        &request,
+        &mut io::stdout().lock(),
+        &mut io::stderr().lock(),
+    )
+    .map_err(|e| match e {
+        raytty::bench::BenchError::Usage(m) => UsageError(m).into(),
+        e => anyhow::Error::new(e),
+    })
 }
 
 /// An error in what the user asked for (exit status 2).

@@ -1,9 +1,10 @@
 //! Rays, triangles and the watertight ray/triangle test.
 //!
 //! The intersection follows Woop, Benthin and Wald, "Watertight Ray/Triangle Intersection"
-//! (JCGT 2013), with the conservative error bound on `t` that pbrt-v4 adds: a ray that passes
-//! exactly through a shared edge or vertex hits at least one of the triangles that share it, and a
-//! hit is never reported at a distance that rounding error cannot tell from zero. New rays leave a
+//! (JCGT 2013), with a conservative error bound on `t` in the spirit of pbrt-v4's but tighter
+//! ([`t_error_bound`]): a ray that passes exactly through a shared edge or vertex hits at least
+//! one of the triangles that share it, and a hit is never reported at a distance that rounding
+//! error cannot tell from zero. New rays leave a
 //! surface from an origin pushed out of the hit point's own rounding-error box
 //! ([`offset_ray_origin`]), so no tuned epsilon depends on the scene's scale.
 
@@ -182,51 +183,100 @@ pub struct TriHit {
     pub b: [f32; 3],
 }
 
+/// A triangle seen from a ray, as the watertight test sees it: the vertices translated to the
+/// ray's origin, their axes permuted so that the ray's largest component is the third
+/// ([`Ray::axes`]), and sheared so that the ray runs along that axis. The ray passes through
+/// the triangle where the origin of the (x, y) plane lies inside the sheared triangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayFrame {
+    /// Sheared x of each vertex: `(v − o)[kx] + sx·(v − o)[kz]`.
+    pub x: [f32; 3],
+    /// Sheared y of each vertex: `(v − o)[ky] + sy·(v − o)[kz]`.
+    pub y: [f32; 3],
+    /// Each vertex's offset along the ray's main axis, `(v − o)[kz]`, not yet scaled by `sz`
+    /// into units of `t`.
+    pub z: [f32; 3],
+}
+
+impl Ray {
+    /// The axes `[kx, ky, kz]` of the watertight test: `kz` is the axis along which `dir` is
+    /// largest in magnitude (the first one on ties), `kx` and `ky` follow it cyclically, swapped
+    /// when `dir[kz] < 0` so that the triangle's winding is kept.
+    pub fn axes(&self) -> [usize; 3] {
+        [self.kx, self.ky, self.kz]
+    }
+
+    /// The shear constants `[sx, sy, sz]`: `sx = −dir[kx]/dir[kz]`, `sy = −dir[ky]/dir[kz]`,
+    /// `sz = 1/dir[kz]`, each as rounded in `f32`.
+    pub fn shear(&self) -> [f32; 3] {
+        [self.sx, self.sy, self.sz]
+    }
+
+    /// The triangle `v` in this ray's frame.
+    #[inline]
+    pub fn frame(&self, v: &[Vec3; 3]) -> RayFrame {
+        let (kx, ky, kz) = (self.kx, self.ky, self.kz);
+        let a = v[0] - self.origin;
+        let b = v[1] - self.origin;
+        let c = v[2] - self.origin;
+        let (az, bz, cz) = (a[kz], b[kz], c[kz]);
+        RayFrame {
+            x: [
+                a[kx] + self.sx * az,
+                b[kx] + self.sx * bz,
+                c[kx] + self.sx * cz,
+            ],
+            y: [
+                a[ky] + self.sy * az,
+                b[ky] + self.sy * bz,
+                c[ky] + self.sy * cz,
+            ],
+            z: [az, bz, cz],
+        }
+    }
+}
+
+impl RayFrame {
+    /// The three edge functions; `e[i]` is the (unnormalised) weight of vertex `i`, the signed
+    /// doubled area of the sheared triangle formed by the other two vertices and the ray. When
+    /// one rounds to exactly zero in `f32`, all three are recomputed in `f64`, where the products
+    /// of `f32` values are exact, so that a ray exactly on an edge gets its sign right.
+    #[inline]
+    pub fn edge_functions(&self) -> [f32; 3] {
+        let (x, y) = (self.x, self.y);
+        let e = [
+            x[1] * y[2] - y[1] * x[2],
+            x[2] * y[0] - y[2] * x[0],
+            x[0] * y[1] - y[0] * x[1],
+        ];
+        if e[0] != 0.0 && e[1] != 0.0 && e[2] != 0.0 {
+            return e;
+        }
+        let (x, y) = (x.map(f64::from), y.map(f64::from));
+        [
+            (x[1] * y[2] - y[1] * x[2]) as f32,
+            (x[2] * y[0] - y[2] * x[0]) as f32,
+            (x[0] * y[1] - y[0] * x[1]) as f32,
+        ]
+    }
+}
+
 /// The watertight ray/triangle test. Two-sided. Returns `None` for a miss, for a hit at or
-/// beyond `t_max`, and for a hit whose `t` is within its own rounding error of zero.
+/// beyond `t_max`, and for a hit whose `t` is within its own rounding error of zero
+/// ([`t_error_bound`]).
 #[inline]
 pub fn intersect_watertight(ray: &Ray, v: &[Vec3; 3], t_max: f32) -> Option<TriHit> {
-    let (kx, ky, kz) = (ray.kx, ray.ky, ray.kz);
-    // Translate to the ray origin, permute so that the ray runs along +z, then shear.
-    let a = v[0] - ray.origin;
-    let b = v[1] - ray.origin;
-    let c = v[2] - ray.origin;
-    let (az, bz, cz) = (a[kz], b[kz], c[kz]);
-    let ax = a[kx] + ray.sx * az;
-    let ay = a[ky] + ray.sy * az;
-    let bx = b[kx] + ray.sx * bz;
-    let by = b[ky] + ray.sy * bz;
-    let cx = c[kx] + ray.sx * cz;
-    let cy = c[ky] + ray.sy * cz;
-
-    // Edge functions; e0 is the weight of vertex 0 (opposite edge b–c), and so on.
-    let mut e0 = bx * cy - by * cx;
-    let mut e1 = cx * ay - cy * ax;
-    let mut e2 = ax * by - ay * bx;
-    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        // Exactly on an edge in f32: decide in f64, where these products are exact.
-        let (ax, ay, bx, by, cx, cy) = (
-            ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64,
-        );
-        e0 = (bx * cy - by * cx) as f32;
-        e1 = (cx * ay - cy * ax) as f32;
-        e2 = (ax * by - ay * bx) as f32;
-    }
-    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+    let frame = ray.frame(v);
+    let e = frame.edge_functions();
+    if (e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0) && (e[0] > 0.0 || e[1] > 0.0 || e[2] > 0.0) {
         return None;
     }
-    let det = e0 + e1 + e2;
+    let det = e[0] + e[1] + e[2];
     if det == 0.0 || det.is_nan() {
         return None;
     }
-
-    // The sheared x and y carry rounding error in proportion to the unscaled z (|sx|, |sy| ≤ 1);
-    // keep that z for the error bound below, before it is scaled into units of t.
-    let z0 = [az.abs(), bz.abs(), cz.abs()];
-    let az = ray.sz * az;
-    let bz = ray.sz * bz;
-    let cz = ray.sz * cz;
-    let t_scaled = e0 * az + e1 * bz + e2 * cz;
+    let z = frame.z.map(|z| ray.sz * z);
+    let t_scaled = e[0] * z[0] + e[1] * z[1] + e[2] * z[2];
     if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
         return None;
     }
@@ -238,49 +288,80 @@ pub fn intersect_watertight(ray: &Ray, v: &[Vec3; 3], t_max: f32) -> Option<TriH
     if !(t < t_max) {
         return None;
     }
-
-    // Conservative bound on the error of t (after pbrt-v4, section 6.8.4): reject hits that
-    // rounding cannot separate from the origin. pbrt bounds all three edge functions by one
-    // error built from the largest |x|, |y| and the scaled z; tests/stability_properties.rs
-    // found real hits it rejects (small distant triangles seen nearly edge-on, and rays whose
-    // direction is not unit length, such as shadow rays). So each edge gets its own bound, and
-    // since t = Σ wᵢ·zᵢ with weights wᵢ = eᵢ/det summing to 1, a weight error moves t only by
-    // |zᵢ − t| per unit, not by the largest |z|.
-    let t_error = EdgeErrors::new([ax, bx, cx], [ay, by, cy], z0, (ray.sx, ray.sy));
-    let max_zt = az.abs().max(bz.abs()).max(cz.abs());
-    let Some(weights_error) = t_error.weights(
-        [e0, e1, e2],
-        det,
-        [az, bz, cz].map(|z| (z - t).abs() + gamma(3) * max_zt),
-    ) else {
-        // The determinant's sign is not certain: the ray lies nearly in the triangle's plane.
-        return None;
-    };
-    // z (one γ₃), the t_scaled sum (γ₃·max|z|), the division (γ₃·t) and the weights; the
-    // factor 2 covers the second-order terms the sum leaves out.
-    let delta_t = 2.0 * (2.0 * gamma(3) * max_zt + gamma(3) * t + weights_error);
+    // A `None` bound: the determinant's sign is not certain (the ray lies nearly in the plane).
+    let delta_t = t_error_bound(ray, &frame, e, t)?;
     if !(t > delta_t) {
         return None;
     }
     Some(TriHit {
         t,
-        b: [e0 * inv_det, e1 * inv_det, e2 * inv_det],
+        b: [e[0] * inv_det, e[1] * inv_det, e[2] * inv_det],
     })
 }
 
+/// A conservative bound on the rounding error of the `t` that [`intersect_watertight`] computes
+/// for `ray` and a triangle whose [`RayFrame`] is `frame`, edge functions `e` and computed
+/// distance `t`, measured against the exact intersection of the same `f32` ray and triangle.
+/// `None` when the edge functions' errors could flip the sign of their sum, the determinant:
+/// the ray lies within rounding of the triangle's plane and no bound on `t` exists.
+///
+/// # Derivation
+///
+/// With γₙ = nε/(1 − nε) bounding the relative error of n roundings (ε = 2⁻²⁴):
+///
+/// 1. Each sheared coordinate `x = (v − o)ₓ + sx·(v − o)_z` carries one rounding from `v − o`,
+///    two from `sx = −dₓ·(1/d_z)`, one from the product and one from the sum, on terms of at
+///    most `|x| + |sx·z|` (z unscaled): δx ≤ γ₅·(|x| + 2|sx·z|), the factor 2 because `|x|` is
+///    the computed sum, not the larger of its terms. The same for y.
+/// 2. Edge function `eᵢ = xⱼ·yₖ − yⱼ·xₖ` inherits its inputs' errors, each times the other
+///    factor, and adds two roundings of its own: δeᵢ ≤ |xⱼ|δyₖ + |yₖ|δxⱼ + |yⱼ|δxₖ + |xₖ|δyⱼ
+///    + γ₂·(|xⱼyₖ| + |yⱼxₖ|).
+/// 3. `t = Σ wᵢ·zᵢ` with weights `wᵢ = eᵢ/det` that sum to 1 (zᵢ now scaled into units of t).
+///    Perturbed weights still sum to 1, so `Σ δwᵢ = 0` and a weight error moves t by
+///    `Σ δwᵢ·(zᵢ − t)`: only the spread of the depths about t matters, not their size. Each
+///    weight is off by at most `(δeᵢ + |wᵢ|·Σδe)/(|det| − Σδe)`, which needs `|det| > Σδe`.
+///    The spread is widened by the depths' own error, γ₃·max|z|.
+/// 4. Rounding after the weights: the scaled depths (γ₃·max|z|, one rounding in `v − o`, two in
+///    `sz·z`), their weighted sum (γ₃·max|z| again: Σ|eᵢ||zᵢ|/|det| ≤ max|z| for a hit, where the
+///    weights are all of one sign) and the division by det (γ₃·t, with the reciprocal).
+///
+/// The sum of 3 and 4, doubled for the second-order terms the first-order analysis leaves out
+/// (products of two errors, the rounding of the bound itself), is the bound.
+///
+/// # Where this departs from pbrt-v4
+///
+/// pbrt-v4 (section 6.8.4 of the book, `IntersectTriangle`) bounds all three edge functions by
+/// one error built from the largest |x|, |y| and the largest *scaled* |z|, and multiplies it by
+/// the largest |z|. Two consequences reject real hits, as `tests/stability_properties.rs` found:
+/// - the sheared x and y carry error in proportion to the *unscaled* z (|sx|, |sy| ≤ 1); using
+///   the scaled z, which is z/d_z, overstates it by 1/|d_z| or more: a ray whose direction is
+///   much shorter than 1 (a shadow ray towards a close light, `dir = light − p`) gets a bound
+///   larger than its t;
+/// - multiplying the weights' error by the largest depth instead of the depths' spread about t
+///   overstates it by t/(depth extent): a small, distant triangle seen nearly edge-on has a
+///   small det and a large t, and pbrt's bound exceeds t.
+///
+/// Here each edge gets its own error from its own operands, in the units the arithmetic really
+/// uses, and the weight error is multiplied by the spread. All of it is `f32` and only runs for
+/// rays that pass the edge tests, so the kernel's cost is unchanged for misses.
+#[inline]
+pub fn t_error_bound(ray: &Ray, frame: &RayFrame, e: [f32; 3], t: f32) -> Option<f32> {
+    let z = frame.z.map(|z| ray.sz * z);
+    let max_zt = z[0].abs().max(z[1].abs()).max(z[2].abs());
+    let det = e[0] + e[1] + e[2];
+    let edge = EdgeErrors::new(frame.x, frame.y, frame.z.map(f32::abs), (ray.sx, ray.sy));
+    let weights_error = edge.weights(e, det, z.map(|z| (z - t).abs() + gamma(3) * max_zt))?;
+    Some(2.0 * (2.0 * gamma(3) * max_zt + gamma(3) * t + weights_error))
+}
+
 /// Bounds on the rounding error of the watertight test's three edge functions, each from its
-/// own operands.
+/// own operands (steps 1 and 2 of [`t_error_bound`]'s derivation).
 struct EdgeErrors {
     e: [f32; 3],
 }
 
 impl EdgeErrors {
-    /// From the sheared vertex coordinates `x`, `y`, the unscaled `|z|` and the shear: each
-    /// sheared coordinate `x = (v − o)ₓ + sx·(v − o)_z` carries one rounding from `v − o`, two
-    /// from the shear constant, one from the product and one from the sum (γ₅), on terms of at
-    /// most `|x| + 2·|sx·z|` in magnitude. Edge
-    /// function `eᵢ = xⱼ·yₖ − yⱼ·xₖ` adds the errors of its inputs times the other factor, and
-    /// two roundings of its own.
+    /// From the sheared vertex coordinates `x`, `y`, the unscaled `|z|` and the shear.
     #[inline]
     fn new(x: [f32; 3], y: [f32; 3], z: [f32; 3], (sx, sy): (f32, f32)) -> EdgeErrors {
         let dx = [0, 1, 2].map(|i| gamma(5) * (x[i].abs() + 2.0 * (sx * z[i]).abs()));
@@ -297,7 +378,7 @@ impl EdgeErrors {
     }
 
     /// How far errors in the weights `eᵢ/det` can move a weighted mean whose terms lie within
-    /// `spread[i]` of it: Σ (δeᵢ + |wᵢ|·Σδe)·spreadᵢ / (|det| − Σδe). `None` when the
+    /// `spread[i]` of it: Σ (δeᵢ + |wᵢ|·Σδe)·spreadᵢ / (|det| − Σδe) (step 3). `None` when the
     /// determinant is not certain to be non-zero.
     #[inline]
     fn weights(&self, e: [f32; 3], det: f32, spread: [f32; 3]) -> Option<f32> {
@@ -315,12 +396,20 @@ impl EdgeErrors {
 }
 
 /// The hit point from barycentrics, and a conservative bound on its absolute error per axis.
+///
+/// The point is clamped into the triangle's bounding box: the exact point lies in it, so the
+/// clamp only moves the computed one closer on each axis and the bound still holds. Without
+/// it, a hit exactly on a crease (a ray along the line where a wall meets the floor) can round
+/// to one ulp behind the neighbouring wall, and a shadow ray from there, offset along its own
+/// normal only, is blocked by that wall.
 #[inline]
 pub fn hit_point(v: &[Vec3; 3], b: [f32; 3]) -> (Vec3, Vec3) {
     let p0 = v[0] * b[0];
     let p1 = v[1] * b[1];
     let p2 = v[2] * b[2];
-    let p = p0 + p1 + p2;
+    let lo = v[0].min(v[1]).min(v[2]);
+    let hi = v[0].max(v[1]).max(v[2]);
+    let p = (p0 + p1 + p2).max(lo).min(hi);
     let err = (p0.abs() + p1.abs() + p2.abs()) * gamma(7);
     (p, err)
 }
@@ -466,6 +555,36 @@ mod tests {
         assert!(intersect_watertight(&ray, &v, f32::INFINITY).is_none());
         let ray = Ray::new(Vec3::ZERO, Vec3::Z);
         assert!(intersect_watertight(&ray, &v, 0.5).is_none());
+    }
+
+    #[test]
+    fn t_error_bound_is_small_head_on_and_none_in_the_plane() {
+        let v = [
+            Vec3::new(-1.0, -1.0, 1.0),
+            Vec3::new(1.0, -1.0, 1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ];
+        // A direction far from unit length, as a shadow ray's `light − p` can be: the bound
+        // stays a few ulps of t (pbrt-v4's grows with t², see `t_error_bound`).
+        let ray = Ray::new(Vec3::ZERO, Vec3::Z * 1e-3);
+        let frame = ray.frame(&v);
+        let e = frame.edge_functions();
+        let hit = intersect_watertight(&ray, &v, f32::INFINITY).expect("head-on hit");
+        let bound = t_error_bound(&ray, &frame, e, hit.t).expect("a bound exists");
+        assert!((hit.t - 1000.0).abs() <= bound, "{hit:?} {bound}");
+        assert!(
+            bound > 0.0 && bound < hit.t * 1e-5,
+            "{bound} for t = {}",
+            hit.t
+        );
+        // In the triangle's plane the determinant is zero: no bound, no hit.
+        let ray = Ray::new(Vec3::new(-2.0, 0.0, 1.0), Vec3::X);
+        let frame = ray.frame(&v);
+        assert_eq!(
+            t_error_bound(&ray, &frame, frame.edge_functions(), 2.0),
+            None
+        );
+        assert_eq!(intersect_watertight(&ray, &v, f32::INFINITY), None);
     }
 
     #[test]

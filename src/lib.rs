@@ -15,7 +15,9 @@
 #![warn(missing_docs)]
 
 pub mod accel;
+pub mod bench;
 pub mod builtin;
+pub mod bvh;
 pub mod camera;
 pub mod cornell;
 pub mod frame;
@@ -26,10 +28,11 @@ pub mod procedural;
 pub mod render;
 pub mod rng;
 pub mod scene;
+pub mod scene_bench;
 pub mod scenefile;
 pub mod shading;
 
-pub use accel::Hit;
+pub use accel::{AccelKind, AccelStats, Hit};
 pub use camera::Camera;
 pub use cornell::cornell_box;
 pub use frame::{CellGrid, ColorMode, encode_diff, encode_text, printable};

@@ -5,8 +5,9 @@
 use std::ops::Range;
 
 use glam::Vec3;
+use rayon::prelude::*;
 
-use crate::accel::{Accel, Hit};
+use crate::accel::{Accel, AccelKind, AccelStats, Hit};
 use crate::camera::Camera;
 use crate::geometry::{Aabb, DegenerateTriangle, Ray, Triangle};
 
@@ -97,6 +98,8 @@ pub struct Scene {
     /// Length of the bounding box's diagonal: the scene's scale.
     pub extent: f32,
     accel: Accel,
+    /// The objects as added (ranges of `triangles`), for rebuilding the flat list.
+    objects: Vec<Range<usize>>,
     has_mirrors: bool,
 }
 
@@ -138,14 +141,16 @@ impl std::fmt::Display for SceneError {
 impl std::error::Error for SceneError {}
 
 /// Collects objects (groups of triangles) and builds a [`Scene`].
+///
+/// Adding is cheap: triangles are validated, in parallel, when the scene is built.
 #[derive(Clone, Debug, Default)]
 pub struct SceneBuilder {
-    triangles: Vec<Triangle>,
+    /// Vertex triples with their material, in the order added.
+    raw: Vec<([Vec3; 3], u32)>,
     objects: Vec<Range<usize>>,
     materials: Vec<Material>,
     lights: Vec<PointLight>,
-    error: Option<SceneError>,
-    added: usize,
+    accel: Option<AccelKind>,
 }
 
 impl SceneBuilder {
@@ -163,20 +168,10 @@ impl SceneBuilder {
     /// Adds an object: triangles given as vertex triples, all of one material. Degenerate
     /// triangles are an error (the first one is reported by [`SceneBuilder::build`]).
     pub fn object(&mut self, triangles: impl IntoIterator<Item = [Vec3; 3]>, material: u32) {
-        let start = self.triangles.len();
-        for [a, b, c] in triangles {
-            match Triangle::new(a, b, c, material) {
-                Ok(t) => self.triangles.push(t),
-                Err(problem) => {
-                    self.error.get_or_insert(SceneError::Triangle {
-                        index: self.added,
-                        problem,
-                    });
-                }
-            }
-            self.added += 1;
-        }
-        self.objects.push(start..self.triangles.len());
+        let start = self.raw.len();
+        self.raw
+            .extend(triangles.into_iter().map(|v| (v, material)));
+        self.objects.push(start..self.raw.len());
     }
 
     /// Adds a light.
@@ -184,15 +179,39 @@ impl SceneBuilder {
         self.lights.push(l);
     }
 
-    /// Validates and builds the scene.
+    /// Forces the acceleration structure (by default the faster one for the triangle count,
+    /// [`AccelKind::for_triangles`]).
+    pub fn accel(&mut self, kind: AccelKind) {
+        self.accel = Some(kind);
+    }
+
+    /// Validates and builds the scene. Triangles are checked in parallel; the error names the
+    /// first bad one in the order added.
     pub fn build(self, name: &str, camera: Camera, effects: Effects) -> Result<Scene, SceneError> {
-        if let Some(e) = self.error {
-            return Err(e);
-        }
-        if let Some(index) = self
-            .triangles
-            .iter()
-            .position(|t| t.material as usize >= self.materials.len())
+        let triangles: Vec<Triangle> = match self
+            .raw
+            .par_iter()
+            .map(|&([a, b, c], m)| Triangle::new(a, b, c, m))
+            .collect::<Result<Vec<_>, _>>()
+        {
+            Ok(t) => t,
+            Err(_) => {
+                // Which one failed first: only on this error path, so sequential is fine.
+                let (index, problem) = self
+                    .raw
+                    .iter()
+                    .enumerate()
+                    .find_map(|(i, &([a, b, c], m))| {
+                        Triangle::new(a, b, c, m).err().map(|e| (i, e))
+                    })
+                    .expect("a triangle failed to validate");
+                return Err(SceneError::Triangle { index, problem });
+            }
+        };
+        let materials = self.materials.len();
+        if let Some(index) = triangles
+            .par_iter()
+            .position_first(|t| t.material as usize >= materials)
         {
             return Err(SceneError::Material { index });
         }
@@ -201,20 +220,23 @@ impl SceneBuilder {
         }) {
             return Err(SceneError::Light { index });
         }
-        let bounds = self
-            .triangles
-            .iter()
-            .fold(Aabb::EMPTY, |b, t| b.union(Aabb::of_triangle(t)));
-        let extent = if self.triangles.is_empty() {
+        let bounds = triangles
+            .par_iter()
+            .map(Aabb::of_triangle)
+            .reduce(|| Aabb::EMPTY, Aabb::union);
+        let extent = if triangles.is_empty() {
             1.0
         } else {
             (bounds.max - bounds.min).length()
         };
-        let accel = Accel::build(&self.triangles, &self.objects);
+        let kind = self
+            .accel
+            .unwrap_or_else(|| AccelKind::for_triangles(triangles.len()));
+        let accel = Accel::build_kind(&triangles, &self.objects, kind);
         let has_mirrors = self.materials.iter().any(|m| m.mirror > 0.0);
         Ok(Scene {
             name: name.to_string(),
-            triangles: self.triangles,
+            triangles,
             materials: self.materials,
             lights: self.lights,
             camera,
@@ -225,6 +247,7 @@ impl SceneBuilder {
                 1.0
             },
             accel,
+            objects: self.objects,
             has_mirrors,
         })
     }
@@ -241,6 +264,24 @@ impl Scene {
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.accel.occluded(&self.triangles, ray, t_max)
+    }
+
+    /// The same scene with its acceleration structure rebuilt as `kind`. Frames do not change:
+    /// every kind finds the same hits (see [`crate::accel`]).
+    pub fn with_accel(mut self, kind: AccelKind) -> Scene {
+        self.accel = Accel::build_kind(&self.triangles, &self.objects, kind);
+        self
+    }
+
+    /// A new acceleration structure of `kind` over this scene's triangles (for timing builds;
+    /// [`Scene::with_accel`] installs one).
+    pub fn build_accel(&self, kind: AccelKind) -> Accel {
+        Accel::build_kind(&self.triangles, &self.objects, kind)
+    }
+
+    /// The acceleration structure's kind, size and build time.
+    pub fn accel_stats(&self) -> AccelStats {
+        self.accel.stats()
     }
 
     /// Whether any material reflects specularly (if not, no reflection ray is ever traced).

@@ -28,24 +28,33 @@ fn default_view_has_no_pixel_wrongly_in_shadow_or_wrongly_lit() {
     let rays = scene.camera.rays(w, h);
     let pixels = reference.frame(&rays, (w, h), &scene.lights, true, 0.0, EDGE_TOL);
     let (mut masked, mut wrongly_dark, mut wrongly_lit) = (0, Vec::new(), Vec::new());
+    // Disagreements inside the mask: what the test would report without it.
+    let (mut masked_dark, mut masked_lit) = (Vec::new(), Vec::new());
     for (k, (want, got)) in pixels.iter().zip(&frame.image.pixels).enumerate() {
-        if want.masked {
-            masked += 1;
-            continue;
-        }
         let (x, y) = (k as u32 % w, k as u32 / w);
         let lit_ref = want.colour.max_element() > 0.0;
         let lit = got.max_element() > 0.0;
+        let (dark, light) = if want.masked {
+            masked += 1;
+            (&mut masked_dark, &mut masked_lit)
+        } else {
+            (&mut wrongly_dark, &mut wrongly_lit)
+        };
         if lit_ref && !lit {
-            wrongly_dark.push((x, y));
+            dark.push((x, y));
         } else if lit && !lit_ref {
-            wrongly_lit.push((x, y));
+            light.push((x, y));
         }
     }
     eprintln!(
-        "{masked} of {} pixels masked at edge tolerance {EDGE_TOL} ({} feature edges)",
+        "{masked} of {} pixels masked at edge tolerance {EDGE_TOL} ({} feature edges); inside \
+         the mask {} wrongly dark {:?}, {} wrongly lit {:?}",
         w * h,
-        reference.edge_count()
+        reference.edge_count(),
+        masked_dark.len(),
+        masked_dark.iter().take(4).collect::<Vec<_>>(),
+        masked_lit.len(),
+        masked_lit.iter().take(4).collect::<Vec<_>>()
     );
     assert!(
         wrongly_dark.is_empty() && wrongly_lit.is_empty(),
@@ -57,6 +66,16 @@ fn default_view_has_no_pixel_wrongly_in_shadow_or_wrongly_lit() {
     );
     // The mask must stay a thin band along the edges, or this test would prove nothing.
     assert!(masked < (w * h) as usize / 100, "{masked} pixels masked");
+    // Even inside the mask no pixel is wrongly in shadow. The diagonal pixels' rays run exactly
+    // along the room's creases; a hit point that rounded one ulp behind the neighbouring wall
+    // used to shadow itself through it (pixels (17, 17) and (482, 482)) until `hit_point`
+    // clamped it into its triangle's box. (Inside the mask, which face of a crease or edge a
+    // ray hits is a legitimate tie, so this asserts only the self-shadowing kind of error;
+    // today the count printed above is zero both ways.)
+    assert!(
+        masked_dark.is_empty(),
+        "pixels in the mask wrongly in shadow: {masked_dark:?}"
+    );
 }
 
 /// A random triangle whose coordinates span 1e-4 to 1e4: a random size, a random place up to
@@ -109,6 +128,7 @@ fn rays_leaving_a_triangle_never_hit_it_again() {
             }
         }
     }
+    eprintln!("{spawned} rays spawned from {TRIANGLES} triangles, none hit its own triangle");
     assert!(
         spawned > TRIANGLES * RAYS_PER_TRIANGLE as u64 / 2,
         "{spawned} rays"

@@ -1,6 +1,7 @@
 //! An `f64` reference tracer of a scene's seed stages (direct light, shadow rays, constant
-//! indirect term), written independently of the library: Möller–Trumbore over every triangle,
-//! no acceleration structure, no offsets. It traces the exact `f32` rays the library traces,
+//! indirect term), written independently of the library: Möller–Trumbore over every triangle
+//! (with a tiny slack that closes its holes along shared edges), no acceleration structure, no
+//! offsets. It traces the exact `f32` rays the library traces,
 //! so the two differ only by the library's rounding.
 
 use std::f64::consts::PI;
@@ -19,6 +20,32 @@ const SELF_HIT_T: f64 = 1e-9;
 
 /// A primary ray that misses is checked for edges out to this many scene diagonals.
 const MISS_REACH: f64 = 10.0;
+
+/// Barycentric slack of the reference's ray/triangle test. Plain Möller–Trumbore is not
+/// watertight: a ray exactly along a crease (the 500×500 view's diagonal pixels) can round to
+/// just outside both faces and see the background. A slack of 1e-12 (barycentrics are
+/// relative to the triangle's size) closes those holes and moves no decision farther than
+/// 1e-12 of a triangle from its edge, far inside the edge masks (`EDGE_TOL` = 2e-5).
+const BARY_SLACK: f64 = 1e-12;
+
+/// Möller–Trumbore in `f64` with [`BARY_SLACK`]: `t` of a hit with `t > 0`.
+fn hit(o: DVec3, dir: DVec3, v: &[DVec3; 3]) -> Option<f64> {
+    let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let s = o - v[0];
+    let u = s.dot(p) / det;
+    let q = s.cross(e1);
+    let w = dir.dot(q) / det;
+    if u < -BARY_SLACK || w < -BARY_SLACK || u + w > 1.0 + BARY_SLACK {
+        return None;
+    }
+    let t = e2.dot(q) / det;
+    (t > 0.0).then_some(t)
+}
 
 /// One reference pixel.
 #[derive(Clone, Copy, Debug)]
@@ -81,7 +108,7 @@ impl Reference {
     pub fn closest(&self, o: DVec3, dir: DVec3, t_min: f64) -> Option<(f64, usize)> {
         let mut best: Option<(f64, usize)> = None;
         for (i, v) in self.tris.iter().enumerate() {
-            if let Some((t, _, _)) = raytty::geometry::intersect_f64(o, dir, *v)
+            if let Some(t) = hit(o, dir, v)
                 && t > t_min
                 && best.is_none_or(|(bt, _)| t < bt)
             {
@@ -93,11 +120,10 @@ impl Reference {
 
     /// Whether anything other than triangle `skip` blocks `o + t·dir` for `SELF_HIT_T < t < t_max`.
     pub fn occluded(&self, o: DVec3, dir: DVec3, t_max: f64, skip: usize) -> bool {
-        self.tris.iter().enumerate().any(|(i, v)| {
-            i != skip
-                && raytty::geometry::intersect_f64(o, dir, *v)
-                    .is_some_and(|(t, _, _)| t > SELF_HIT_T && t < t_max)
-        })
+        self.tris
+            .iter()
+            .enumerate()
+            .any(|(i, v)| i != skip && hit(o, dir, v).is_some_and(|t| t > SELF_HIT_T && t < t_max))
     }
 
     /// The reference colour of the `f32` ray `ray`, with `ambient` as the constant indirect

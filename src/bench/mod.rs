@@ -1,0 +1,418 @@
+//! `raytty bench`: what each step of accuracy costs in time. Every row renders the Cornell box
+//! (or any scene) at one size with one set of effects, several times after a warm-up, and is
+//! compared with a path-traced reference that is rendered once and cached on disk.
+//!
+//! The library side of the command: the rows, the timing, the errors, and the outputs (a
+//! Markdown table, CSV, an SVG plot, the README block). The binary only parses the flags.
+
+pub mod command;
+pub mod metrics;
+pub mod output;
+pub mod reference;
+
+use std::io;
+use std::path::PathBuf;
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+use crate::frame::{CellGrid, ColorMode, encode_text};
+use crate::image::Image;
+use crate::render::render;
+use crate::scene::{Effects, Indirect, Scene};
+use crate::shading::{Mode, RayCounts, Settings, Stage};
+
+pub use command::{BenchError, BenchRequest, run_command};
+pub use output::{csv, markdown, rewrite_readme, svg};
+pub use reference::{ReferenceInfo, ReferenceSpec};
+
+/// The seed's stages that get a row each (stage 6, GI, has its own rows).
+pub const SEED_STAGES: [Stage; 5] = [
+    Stage::Flat,
+    Stage::Light,
+    Stage::Direct,
+    Stage::Shadows,
+    Stage::Indirect,
+];
+
+/// Anti-aliasing rows: the seed's effects at these samples per pixel.
+pub const AA_SPP: [u32; 2] = [4, 16];
+
+/// GI rows: these bounce counts, each at a ladder of samples per pixel.
+pub const GI_BOUNCES: [u32; 4] = [1, 2, 4, 8];
+
+/// What to measure.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchOptions {
+    /// Image sizes in pixels, width × height.
+    pub sizes: Vec<(u32, u32)>,
+    /// Timed runs per row, after one warm-up run.
+    pub runs: u32,
+    /// The GI ladder goes 1, 4, 16, … up to this many samples per pixel.
+    pub max_spp: u32,
+    /// The reference's samples per pixel.
+    pub ref_spp: u32,
+    /// The reference's maximum bounces.
+    pub ref_bounces: u32,
+    /// Where references are cached.
+    pub cache_dir: PathBuf,
+    /// Show progress bars on stderr (only when it is a terminal).
+    pub progress: bool,
+}
+
+impl BenchOptions {
+    /// The full bench: the seed's 500×500 and a 200×100 terminal frame, 5 runs, GI up to 64
+    /// spp, against a 1024 spp, 16-bounce reference.
+    pub fn full() -> BenchOptions {
+        BenchOptions {
+            sizes: vec![(500, 500), (200, 100)],
+            runs: 5,
+            max_spp: 64,
+            ref_spp: 1024,
+            ref_bounces: 16,
+            cache_dir: reference::default_cache_dir(),
+            progress: true,
+        }
+    }
+
+    /// A bench that runs in a second or two (for tests): tiny sizes, 2 runs, GI up to 4 spp,
+    /// a 64 spp, 8-bounce reference.
+    pub fn quick() -> BenchOptions {
+        BenchOptions {
+            sizes: vec![(40, 40), (32, 16)],
+            runs: 2,
+            max_spp: 4,
+            ref_spp: 64,
+            ref_bounces: 8,
+            ..BenchOptions::full()
+        }
+    }
+
+    /// The GI ladder of samples per pixel: 1, 4, 16, … ≤ `max_spp`.
+    pub fn spp_ladder(&self) -> Vec<u32> {
+        std::iter::successors(Some(1u32), |s| s.checked_mul(4))
+            .take_while(|&s| s <= self.max_spp.max(1))
+            .collect()
+    }
+}
+
+/// What a row measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RowKind {
+    /// One of the seed's stages, 1 sample per pixel (`Indirect` is the seed's constant N).
+    Stage(Stage),
+    /// The seed's effects with stratified anti-aliasing.
+    Aa {
+        /// Samples per pixel.
+        spp: u32,
+    },
+    /// Path-traced global illumination.
+    Gi {
+        /// Maximum bounces.
+        bounces: u32,
+        /// Samples per pixel.
+        spp: u32,
+    },
+}
+
+impl RowKind {
+    /// A short name for tables and plots.
+    pub fn label(&self) -> String {
+        match *self {
+            RowKind::Stage(Stage::Indirect) => "indirect (seed, N = 0.5)".into(),
+            RowKind::Stage(s) => s.name().into(),
+            RowKind::Aa { .. } => "AA (seed, N = 0.5)".into(),
+            RowKind::Gi { .. } => "GI".into(),
+        }
+    }
+
+    /// Samples per pixel.
+    pub fn spp(&self) -> u32 {
+        match *self {
+            RowKind::Stage(_) => 1,
+            RowKind::Aa { spp } | RowKind::Gi { spp, .. } => spp,
+        }
+    }
+
+    /// Maximum bounces (GI rows only).
+    pub fn bounces(&self) -> Option<u32> {
+        match *self {
+            RowKind::Gi { bounces, .. } => Some(bounces),
+            _ => None,
+        }
+    }
+
+    /// The settings the row renders with.
+    pub fn settings(&self, scene: &Scene) -> Settings {
+        match *self {
+            RowKind::Stage(s) => s.settings(scene.effects),
+            RowKind::Aa { spp } => {
+                let mut s = Stage::Indirect.settings(scene.effects);
+                s.effects.samples = spp;
+                s
+            }
+            RowKind::Gi { bounces, spp } => Settings {
+                mode: Mode::Colour,
+                effects: Effects {
+                    shadows: true,
+                    indirect: Indirect::PathTraced { bounces },
+                    samples: spp,
+                },
+                frame: 0,
+            },
+        }
+    }
+
+    /// A rough cost, for the progress bar: samples times (bounces + 1).
+    fn weight(&self) -> u64 {
+        u64::from(self.spp()) * (1 + u64::from(self.bounces().unwrap_or(0)))
+    }
+}
+
+/// One measured row.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// What was rendered.
+    pub kind: RowKind,
+    /// Median wall-clock time per frame, in milliseconds.
+    pub median_ms: f64,
+    /// Fastest run, in milliseconds.
+    pub min_ms: f64,
+    /// Slowest run, in milliseconds.
+    pub max_ms: f64,
+    /// Rays traced per frame, by kind.
+    pub rays: RayCounts,
+    /// Millions of rays per second at the median time.
+    pub mrays_per_s: f64,
+    /// RMSE of the linear values against the reference.
+    pub rmse: f64,
+    /// PSNR of the 8-bit image against the reference's, in dB (infinite if equal).
+    pub psnr: f64,
+    /// Bytes of one whole truecolor frame at the matching cell size (width × height/2 cells).
+    pub ansi_bytes: usize,
+}
+
+/// Where and when the numbers were taken.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Environment {
+    /// UTC date and time, `YYYY-MM-DD HH:MM UTC`.
+    pub date: String,
+    /// The CPU model (from /proc/cpuinfo where there is one) and the architecture.
+    pub machine: String,
+    /// Threads the renders ran on (rayon's pool).
+    pub threads: usize,
+    /// One-minute load averages at the start and the end (where the OS reports them).
+    pub load: Option<(f64, f64)>,
+}
+
+/// Everything a bench run measured.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchReport {
+    /// The rows, size by size, in the order of [`rows_for`].
+    pub rows: Vec<Row>,
+    /// The reference of each size.
+    pub references: Vec<ReferenceInfo>,
+    /// Where and when.
+    pub environment: Environment,
+}
+
+/// The rows of one size: the seed's stages, anti-aliasing, then GI by bounces and samples.
+pub fn rows_for(options: &BenchOptions) -> Vec<RowKind> {
+    let mut rows: Vec<RowKind> = SEED_STAGES.iter().map(|&s| RowKind::Stage(s)).collect();
+    rows.extend(AA_SPP.iter().map(|&spp| RowKind::Aa { spp }));
+    for bounces in GI_BOUNCES {
+        for spp in options.spp_ladder() {
+            rows.push(RowKind::Gi { bounces, spp });
+        }
+    }
+    rows
+}
+
+/// Runs the bench on `scene`: references first (cached), then every row of every size.
+pub fn run(scene: &Scene, options: &BenchOptions) -> io::Result<BenchReport> {
+    let load_start = load_average();
+    let mut references = Vec::new();
+    let mut images = Vec::new();
+    for &(w, h) in &options.sizes {
+        let spec = ReferenceSpec::new(scene, w, h, options.ref_spp, options.ref_bounces);
+        let (img, info) =
+            reference::load_or_render(scene, &spec, &options.cache_dir, options.progress)?;
+        images.push(img);
+        references.push(info);
+    }
+
+    let kinds = rows_for(options);
+    let runs = options.runs.max(1);
+    let total: u64 = kinds
+        .iter()
+        .map(|k| k.weight() * u64::from(runs + 1))
+        .sum::<u64>()
+        * options.sizes.len() as u64;
+    let bar = reference::progress_bar(total, "bench", options.progress);
+    let mut rows = Vec::new();
+    for (&(w, h), reference) in options.sizes.iter().zip(&images) {
+        for kind in &kinds {
+            bar.set_message(format!(
+                "{w}x{h} {} {}spp",
+                kind.label().split(' ').next().unwrap_or(""),
+                kind.spp()
+            ));
+            rows.push(measure(scene, *kind, w, h, runs, reference, || {
+                bar.inc(kind.weight())
+            }));
+        }
+    }
+    bar.finish_and_clear();
+    let load_end = load_average();
+    Ok(BenchReport {
+        rows,
+        references,
+        environment: Environment {
+            date: utc_now(),
+            machine: machine(),
+            threads: rayon::current_num_threads(),
+            load: load_start.zip(load_end),
+        },
+    })
+}
+
+/// Renders one row `runs + 1` times (the first is a warm-up) and measures it.
+fn measure(
+    scene: &Scene,
+    kind: RowKind,
+    width: u32,
+    height: u32,
+    runs: u32,
+    reference: &Image,
+    mut tick: impl FnMut(),
+) -> Row {
+    let settings = kind.settings(scene);
+    let once = || {
+        let start = Instant::now();
+        let f = render(
+            scene,
+            &scene.camera,
+            &scene.lights,
+            &settings,
+            width,
+            height,
+        );
+        (f, start.elapsed())
+    };
+    let (frame, _) = once();
+    tick();
+    let mut times: Vec<Duration> = Vec::with_capacity(runs as usize);
+    for _ in 0..runs {
+        let (f, t) = once();
+        debug_assert_eq!(f.image, frame.image, "frames are deterministic");
+        times.push(t);
+        tick();
+    }
+    times.sort();
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    let mid = times.len() / 2;
+    let median_ms = if times.len() % 2 == 1 {
+        ms(times[mid])
+    } else {
+        0.5 * (ms(times[mid - 1]) + ms(times[mid]))
+    };
+    let rays = frame.stats.rays;
+    Row {
+        width,
+        height,
+        kind,
+        median_ms,
+        min_ms: ms(times[0]),
+        max_ms: ms(times[times.len() - 1]),
+        rays,
+        mrays_per_s: rays.total() as f64 / (median_ms * 1e-3).max(1e-9) / 1e6,
+        rmse: metrics::rmse(&frame.image, reference),
+        psnr: metrics::psnr8(&frame.image, reference),
+        ansi_bytes: encode_text(&CellGrid::from_image(&frame.image, ColorMode::TrueColor)).len(),
+    }
+}
+
+/// The one-minute load average, where the OS reports it (Linux).
+fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+/// The CPU model and the architecture.
+fn machine() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo").ok().and_then(|s| {
+        s.lines()
+            .find(|l| l.starts_with("model name"))
+            .and_then(|l| l.split_once(':'))
+            .map(|(_, m)| m.trim().to_string())
+    });
+    let arch = std::env::consts::ARCH;
+    match model {
+        Some(m) => format!("{m} ({arch})"),
+        None => arch.to_string(),
+    }
+}
+
+/// Now as `YYYY-MM-DD HH:MM UTC`.
+fn utc_now() -> String {
+    let secs = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    utc(secs)
+}
+
+/// Seconds since the Unix epoch as `YYYY-MM-DD HH:MM UTC` (the proleptic Gregorian calendar;
+/// the day count to civil date conversion of Howard Hinnant's `civil_from_days`).
+fn utc(secs: u64) -> String {
+    let days = (secs / 86_400) as i64;
+    let (hh, mm) = ((secs % 86_400) / 3600, (secs % 3600) / 60);
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02} {hh:02}:{mm:02} UTC")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dates() {
+        assert_eq!(utc(0), "1970-01-01 00:00 UTC");
+        assert_eq!(utc(951_782_400), "2000-02-29 00:00 UTC");
+        assert_eq!(utc(1_795_437_000), "2026-11-23 12:30 UTC");
+    }
+
+    #[test]
+    fn the_ladder_goes_up_by_four() {
+        let mut o = BenchOptions::quick();
+        o.max_spp = 64;
+        assert_eq!(o.spp_ladder(), [1, 4, 16, 64]);
+        o.max_spp = 100;
+        assert_eq!(o.spp_ladder(), [1, 4, 16, 64]);
+        o.max_spp = 1;
+        assert_eq!(o.spp_ladder(), [1]);
+    }
+
+    #[test]
+    fn rows_cover_the_stages_aa_and_every_bounce_count() {
+        let o = BenchOptions::quick();
+        let rows = rows_for(&o);
+        assert_eq!(rows.len(), 5 + 2 + 4 * o.spp_ladder().len());
+        assert_eq!(rows[4], RowKind::Stage(Stage::Indirect));
+        assert_eq!(rows[6], RowKind::Aa { spp: 16 });
+        assert_eq!(rows.last(), Some(&RowKind::Gi { bounces: 8, spp: 4 }));
+    }
+}

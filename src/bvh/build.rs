@@ -1,0 +1,567 @@
+//! Building the hierarchy: binned SAH, top levels in parallel.
+//!
+//! Deterministic for any number of threads: a node's split depends only on the triangles it
+//! holds (bounds are min/max and counts integer sums, both exact in any order), partitioning is
+//! sequential within a node, and the two halves of a split are built independently and laid
+//! out left then right.
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::{MAX_DEPTH, Node, NodePair};
+use crate::geometry::Triangle;
+
+/// Number of SAH bins per axis.
+pub const SAH_BINS: usize = 16;
+
+/// Most triangles in a leaf: larger nodes are always split.
+pub const LEAF_MAX: usize = 8;
+
+/// Cost of visiting a node (two slab tests) relative to one triangle test, for the SAH.
+const TRAVERSAL_COST: f64 = 1.0;
+
+/// Below this depth nodes split by SAH; deeper ones split at the median, which halves the count
+/// each level, so no tree is deeper than this plus log₂(2³²): within [`MAX_DEPTH`].
+const SAH_DEPTH: u32 = 30;
+
+/// Nodes with at least this many triangles build their two halves in parallel.
+const PARALLEL_NODE: usize = 8 * 1024;
+
+/// Nodes with at most this many triangles are split by the exact SAH (every cut between sorted
+/// centroids) rather than by bins.
+const SMALL_NODE: usize = 16;
+
+/// Nodes with at least this many triangles also compute their bounds and bins in parallel.
+const PARALLEL_PASS: usize = 64 * 1024;
+
+/// Chunk size for the parallel passes.
+const CHUNK: usize = 16 * 1024;
+
+/// A triangle's box and its scene index, the unit the builder sorts.
+#[derive(Clone, Copy, Debug)]
+struct PrimRef {
+    min: Vec3,
+    max: Vec3,
+    id: u32,
+}
+
+impl PrimRef {
+    /// The box's centre along `axis` (each term halved first, so huge coordinates cannot
+    /// overflow).
+    #[inline]
+    fn centroid(&self, axis: usize) -> f32 {
+        self.min[axis] * 0.5 + self.max[axis] * 0.5
+    }
+}
+
+/// Box bounds as plain min/max; `EMPTY` is the identity of `union`.
+#[derive(Clone, Copy, Debug)]
+struct Bounds {
+    min: Vec3,
+    max: Vec3,
+}
+
+impl Bounds {
+    const EMPTY: Bounds = Bounds {
+        min: Vec3::INFINITY,
+        max: Vec3::NEG_INFINITY,
+    };
+
+    #[inline]
+    fn grow(&mut self, min: Vec3, max: Vec3) {
+        self.min = self.min.min(min);
+        self.max = self.max.max(max);
+    }
+
+    #[inline]
+    fn union(mut self, o: Bounds) -> Bounds {
+        self.grow(o.min, o.max);
+        self
+    }
+
+    /// Surface area in `f64` (f32 extents of huge boxes would overflow when multiplied).
+    fn area(&self) -> f64 {
+        if !(self.min.x <= self.max.x) {
+            return 0.0;
+        }
+        let d = self.max.as_dvec3() - self.min.as_dvec3();
+        2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
+    }
+}
+
+/// A node's box and the box of its triangles' centroids.
+#[derive(Clone, Copy, Debug)]
+struct NodeBounds {
+    bounds: Bounds,
+    centroids: Bounds,
+}
+
+impl NodeBounds {
+    const EMPTY: NodeBounds = NodeBounds {
+        bounds: Bounds::EMPTY,
+        centroids: Bounds::EMPTY,
+    };
+
+    fn union(self, o: NodeBounds) -> NodeBounds {
+        NodeBounds {
+            bounds: self.bounds.union(o.bounds),
+            centroids: self.centroids.union(o.centroids),
+        }
+    }
+
+    fn of(refs: &[PrimRef]) -> NodeBounds {
+        let fold = |refs: &[PrimRef]| {
+            let mut b = NodeBounds::EMPTY;
+            for r in refs {
+                b.bounds.grow(r.min, r.max);
+                let c = r.min * 0.5 + r.max * 0.5;
+                b.centroids.grow(c, c);
+            }
+            b
+        };
+        if refs.len() >= PARALLEL_PASS {
+            refs.par_chunks(CHUNK)
+                .map(fold)
+                .reduce(|| NodeBounds::EMPTY, NodeBounds::union)
+        } else {
+            fold(refs)
+        }
+    }
+}
+
+/// The mapping of centroids to bins along one axis.
+#[derive(Clone, Copy, Debug)]
+struct Binning {
+    axis: usize,
+    lo: f32,
+    scale: f32,
+}
+
+impl Binning {
+    /// `None` when the centroids do not spread along `axis`. The scale is computed in `f64`
+    /// (the extent may overflow `f32`); a centroid distance that overflows lands in the last bin,
+    /// on both the binning and the partitioning pass alike.
+    fn new(centroids: &Bounds, axis: usize) -> Option<Binning> {
+        let lo = centroids.min[axis];
+        let extent = f64::from(centroids.max[axis]) - f64::from(lo);
+        let scale = (SAH_BINS as f64 / extent) as f32;
+        (extent > 0.0 && scale.is_finite() && scale > 0.0).then_some(Binning { axis, lo, scale })
+    }
+
+    #[inline]
+    fn bin(&self, c: Vec3) -> usize {
+        (((c[self.axis] - self.lo) * self.scale) as usize).min(SAH_BINS - 1)
+    }
+}
+
+/// One axis's bins: boxes and counts.
+#[derive(Clone, Copy, Debug)]
+struct AxisBins {
+    min: [Vec3; SAH_BINS],
+    max: [Vec3; SAH_BINS],
+    count: [u32; SAH_BINS],
+}
+
+impl AxisBins {
+    const EMPTY: AxisBins = AxisBins {
+        min: [Vec3::INFINITY; SAH_BINS],
+        max: [Vec3::NEG_INFINITY; SAH_BINS],
+        count: [0; SAH_BINS],
+    };
+
+    fn bounds(&self, k: usize) -> Bounds {
+        Bounds {
+            min: self.min[k],
+            max: self.max[k],
+        }
+    }
+}
+
+type Bins = [AxisBins; 3];
+
+fn union_bins(mut a: Bins, b: Bins) -> Bins {
+    for (x, y) in a.iter_mut().zip(&b) {
+        for k in 0..SAH_BINS {
+            x.min[k] = x.min[k].min(y.min[k]);
+            x.max[k] = x.max[k].max(y.max[k]);
+            x.count[k] += y.count[k];
+        }
+    }
+    a
+}
+
+fn bin_all(refs: &[PrimRef], binnings: &[Option<Binning>; 3]) -> Bins {
+    let fold = |refs: &[PrimRef]| {
+        let mut bins = [AxisBins::EMPTY; 3];
+        for r in refs {
+            let c = r.min * 0.5 + r.max * 0.5;
+            for (bins, b) in bins.iter_mut().zip(binnings) {
+                if let Some(b) = b {
+                    let k = b.bin(c);
+                    bins.min[k] = bins.min[k].min(r.min);
+                    bins.max[k] = bins.max[k].max(r.max);
+                    bins.count[k] += 1;
+                }
+            }
+        }
+        bins
+    };
+    if refs.len() >= PARALLEL_PASS {
+        refs.par_chunks(CHUNK)
+            .map(fold)
+            .reduce(|| [AxisBins::EMPTY; 3], union_bins)
+    } else {
+        fold(refs)
+    }
+}
+
+/// How a node is split.
+enum Split {
+    /// Make a leaf.
+    Leaf,
+    /// Triangles whose centroid falls in a bin below `bin` go left.
+    Binned(Binning, usize),
+    /// Sort by centroid along the axis (ties by scene index) and cut at this many.
+    Sorted(usize, usize),
+    /// All centroids coincide: cut the list in two as it is.
+    Halve,
+}
+
+/// The built hierarchy: sibling pairs (the root alone in the first), and the scene indices in
+/// leaf order.
+pub(super) struct Built {
+    pub pairs: Vec<NodePair>,
+    pub order: Vec<u32>,
+    pub depth: u32,
+}
+
+/// Builds the hierarchy over `triangles`.
+pub(super) fn build(triangles: &[Triangle]) -> Built {
+    if triangles.is_empty() {
+        return Built {
+            pairs: Vec::new(),
+            order: Vec::new(),
+            depth: 0,
+        };
+    }
+    let mut refs: Vec<PrimRef> = triangles
+        .par_iter()
+        .enumerate()
+        .map(|(i, t)| PrimRef {
+            min: t.v[0].min(t.v[1]).min(t.v[2]),
+            max: t.v[0].max(t.v[1]).max(t.v[2]),
+            id: i as u32,
+        })
+        .collect();
+    let (mut root, below, depth) = subtree(&mut refs, 0, 1);
+    debug_assert!(depth as usize <= MAX_DEPTH);
+    if !root.is_leaf() {
+        // The root's children are the next pair: flat index 2.
+        root.offset = 2;
+    }
+    let mut pairs = Vec::with_capacity(1 + below.len());
+    pairs.push(NodePair([root, Node::UNUSED]));
+    below.flatten(&mut pairs);
+    Built {
+        pairs,
+        order: refs.par_iter().map(|r| r.id).collect(),
+        depth,
+    }
+}
+
+/// What lies below a subtree's root, as built: sibling pairs, the first one the root's
+/// children. Flattened once at the end, so no node is copied twice.
+enum Part {
+    /// Built in one go. An interior node's `offset` is the index in this list of its
+    /// children's pair.
+    Pairs(Vec<NodePair>),
+    /// The root's two children, whose subtrees were built in parallel, and what lies below
+    /// each; with the total number of pairs.
+    Join([Node; 2], Box<[Part; 2]>, usize),
+}
+
+impl Part {
+    /// Number of pairs.
+    fn len(&self) -> usize {
+        match self {
+            Part::Pairs(v) => v.len(),
+            Part::Join(_, _, len) => *len,
+        }
+    }
+
+    /// Appends the pairs to `out`, every interior node's `offset` becoming the flat index of
+    /// its first child (its pair's index times two).
+    fn flatten(self, out: &mut Vec<NodePair>) {
+        match self {
+            Part::Pairs(v) => {
+                let base = out.len();
+                out.extend(v.into_iter().map(|mut pair| {
+                    for node in &mut pair.0 {
+                        if !node.is_leaf() {
+                            node.offset = (2 * (base + node.offset as usize)) as u32;
+                        }
+                    }
+                    pair
+                }));
+            }
+            Part::Join(mut children, below, _) => {
+                let at = out.len();
+                out.push(NodePair([Node::UNUSED; 2]));
+                for (child, below) in children.iter_mut().zip(*below) {
+                    if !child.is_leaf() {
+                        child.offset = (2 * out.len()) as u32;
+                    }
+                    below.flatten(out);
+                }
+                out[at] = NodePair(children);
+            }
+        }
+    }
+}
+
+/// Builds the subtree over `refs` (whose first entry is at `first` in leaf order) at level
+/// `depth`: its root (an interior root's `offset` is set by the caller), what lies below it,
+/// and the deepest level reached. Halves of large nodes are built in parallel.
+fn subtree(refs: &mut [PrimRef], first: usize, depth: u32) -> (Node, Part, u32) {
+    if refs.len() < PARALLEL_NODE {
+        let mut pairs = Vec::with_capacity(refs.len() / 2);
+        let (root, d) = build_node(refs, first, depth, &mut pairs);
+        return (root, Part::Pairs(pairs), d);
+    }
+    let nb = NodeBounds::of(refs);
+    let Some(mid) = split(refs, &nb, depth) else {
+        // (Only nodes of at most LEAF_MAX triangles become leaves.)
+        return (leaf(&nb, first, refs.len()), Part::Pairs(Vec::new()), depth);
+    };
+    let (left, right) = refs.split_at_mut(mid);
+    let ((l, l_below, l_depth), (r, r_below, r_depth)) = rayon::join(
+        || subtree(left, first, depth + 1),
+        || subtree(right, first + mid, depth + 1),
+    );
+    let len = 1 + l_below.len() + r_below.len();
+    (
+        interior(&nb, 0),
+        Part::Join([l, r], Box::new([l_below, r_below]), len),
+        l_depth.max(r_depth),
+    )
+}
+
+/// A leaf over the `n` triangles from `first` in leaf order.
+fn leaf(nb: &NodeBounds, first: usize, n: usize) -> Node {
+    Node {
+        min: nb.bounds.min,
+        offset: first as u32,
+        max: nb.bounds.max,
+        count: n as u32,
+    }
+}
+
+/// An interior node whose children are at `offset`.
+fn interior(nb: &NodeBounds, offset: usize) -> Node {
+    Node {
+        min: nb.bounds.min,
+        offset: offset as u32,
+        max: nb.bounds.max,
+        count: 0,
+    }
+}
+
+/// Builds the subtree over `refs` sequentially, appending the pairs below its root to `out`;
+/// returns the root (an interior root's `offset` is its children's index in `out`) and the
+/// deepest level reached.
+fn build_node(
+    refs: &mut [PrimRef],
+    first: usize,
+    depth: u32,
+    out: &mut Vec<NodePair>,
+) -> (Node, u32) {
+    let n = refs.len();
+    let nb = NodeBounds::of(refs);
+    let Some(mid) = split(refs, &nb, depth) else {
+        return (leaf(&nb, first, n), depth);
+    };
+    let at = out.len();
+    out.push(NodePair([Node::UNUSED; 2]));
+    let (left, right) = refs.split_at_mut(mid);
+    let (l, l_depth) = build_node(left, first, depth + 1, out);
+    let (r, r_depth) = build_node(right, first + mid, depth + 1, out);
+    out[at] = NodePair([l, r]);
+    (interior(&nb, at), l_depth.max(r_depth))
+}
+
+/// Decides how to split the node and reorders `refs` so that the left half comes first;
+/// returns the left half's size, or `None` for a leaf.
+fn split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32) -> Option<usize> {
+    let n = refs.len();
+    let mid = match choose_split(refs, nb, depth) {
+        Split::Leaf => return None,
+        Split::Binned(binning, bin) => {
+            partition(refs, |r| binning.bin(r.min * 0.5 + r.max * 0.5) < bin)
+        }
+        Split::Sorted(axis, mid) => {
+            let key = |r: &PrimRef| (r.centroid(axis), r.id);
+            if n <= SMALL_NODE {
+                refs.sort_unstable_by(|a, b| {
+                    let (a, b) = (key(a), key(b));
+                    a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
+                });
+            } else {
+                refs.select_nth_unstable_by(mid, |a, b| {
+                    let (a, b) = (key(a), key(b));
+                    a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
+                });
+            }
+            mid
+        }
+        Split::Halve => n / 2,
+    };
+    debug_assert!(0 < mid && mid < n);
+    Some(mid)
+}
+
+/// Picks how to split a node of `refs.len()` triangles with bounds `nb`.
+fn choose_split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32) -> Split {
+    let n = refs.len();
+    if n == 1 {
+        return Split::Leaf;
+    }
+    let c = &nb.centroids;
+    if c.min == c.max {
+        return if n <= LEAF_MAX {
+            Split::Leaf
+        } else {
+            Split::Halve
+        };
+    }
+    let widest = {
+        let d = c.max.as_dvec3() - c.min.as_dvec3();
+        if d.x >= d.y && d.x >= d.z {
+            0
+        } else if d.y >= d.z {
+            1
+        } else {
+            2
+        }
+    };
+    if depth >= SAH_DEPTH {
+        return if n <= LEAF_MAX {
+            Split::Leaf
+        } else {
+            Split::Sorted(widest, n / 2)
+        };
+    }
+    let area = nb.bounds.area();
+    let (best, split) = if n <= SMALL_NODE {
+        small_sah(refs, c)
+    } else {
+        binned_sah(refs, c)
+    };
+    match (best, split) {
+        (Some(cost), Some(split)) if cost.is_finite() && area.is_finite() && area > 0.0 => {
+            let split_cost = TRAVERSAL_COST + cost / area;
+            if n <= LEAF_MAX && n as f64 <= split_cost {
+                Split::Leaf
+            } else {
+                split
+            }
+        }
+        // No split separates the centroids, or the areas overflowed: cut at the median.
+        _ if n <= LEAF_MAX => Split::Leaf,
+        _ => Split::Sorted(widest, n / 2),
+    }
+}
+
+/// The binned SAH: the cheapest cut between bins on any axis, as `(A_L·N_L + A_R·N_R, split)`.
+fn binned_sah(refs: &[PrimRef], c: &Bounds) -> (Option<f64>, Option<Split>) {
+    let n = refs.len() as u64;
+    let binnings = [0, 1, 2].map(|a| Binning::new(c, a));
+    let bins = bin_all(refs, &binnings);
+    let mut best: Option<(f64, Binning, usize)> = None;
+    for (b, bins) in binnings.iter().zip(&bins) {
+        let Some(b) = b else { continue };
+        let mut right_cost = [0f64; SAH_BINS];
+        let mut acc = Bounds::EMPTY;
+        let mut count = 0u64;
+        for k in (1..SAH_BINS).rev() {
+            acc = acc.union(bins.bounds(k));
+            count += u64::from(bins.count[k]);
+            right_cost[k] = acc.area() * count as f64;
+        }
+        let mut acc = Bounds::EMPTY;
+        let mut count = 0u64;
+        for (k, right) in right_cost.iter().enumerate().skip(1) {
+            acc = acc.union(bins.bounds(k - 1));
+            count += u64::from(bins.count[k - 1]);
+            if count == 0 || count == n {
+                continue;
+            }
+            let cost = acc.area() * count as f64 + right;
+            if best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, *b, k));
+            }
+        }
+    }
+    match best {
+        Some((cost, b, k)) => (Some(cost), Some(Split::Binned(b, k))),
+        None => (None, None),
+    }
+}
+
+/// The exact SAH for a small node: every cut between centroids sorted along each axis.
+fn small_sah(refs: &mut [PrimRef], c: &Bounds) -> (Option<f64>, Option<Split>) {
+    let n = refs.len();
+    let mut best: Option<(f64, usize, usize)> = None;
+    let mut right_cost = [0f64; SMALL_NODE];
+    for axis in 0..3 {
+        if !(c.max[axis] > c.min[axis]) {
+            continue;
+        }
+        refs.sort_unstable_by(|a, b| {
+            a.centroid(axis)
+                .total_cmp(&b.centroid(axis))
+                .then(a.id.cmp(&b.id))
+        });
+        let mut acc = Bounds::EMPTY;
+        for k in (1..n).rev() {
+            acc.grow(refs[k].min, refs[k].max);
+            right_cost[k] = acc.area() * (n - k) as f64;
+        }
+        let mut acc = Bounds::EMPTY;
+        for k in 1..n {
+            acc.grow(refs[k - 1].min, refs[k - 1].max);
+            // Cut only between distinct centroids, so the halves' centroid boxes shrink.
+            if refs[k - 1].centroid(axis) == refs[k].centroid(axis) {
+                continue;
+            }
+            let cost = acc.area() * k as f64 + right_cost[k];
+            if best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, axis, k));
+            }
+        }
+    }
+    match best {
+        Some((cost, axis, k)) => (Some(cost), Some(Split::Sorted(axis, k))),
+        None => (None, None),
+    }
+}
+
+/// Moves the entries for which `left` holds to the front (in a fixed order: the result depends
+/// only on the input) and returns how many there are.
+fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool) -> usize {
+    let mut i = 0;
+    let mut j = refs.len();
+    loop {
+        while i < j && left(&refs[i]) {
+            i += 1;
+        }
+        while i < j && !left(&refs[j - 1]) {
+            j -= 1;
+        }
+        if i >= j {
+            return i;
+        }
+        refs.swap(i, j - 1);
+        i += 1;
+        j -= 1;
+    }
+}

@@ -1,0 +1,191 @@
+//! What a scene costs: the acceleration structure's build time, and frame times and ray
+//! throughput at a few sizes for the effects the scene calls for (stage `indirect`).
+//!
+//! This is the library side of `raytty bench --scene NAME`; the numbers it reports depend on
+//! the machine, so no test asserts them.
+
+use std::fmt::Write as _;
+use std::time::{Duration, Instant};
+
+use crate::accel::AccelStats;
+use crate::render::render;
+use crate::scene::Scene;
+use crate::shading::Stage;
+
+/// Frame times at one size.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SizeBench {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Timed frames (after one untimed warm-up frame).
+    pub runs: u32,
+    /// Median frame time.
+    pub median: Duration,
+    /// Fastest frame.
+    pub min: Duration,
+    /// Slowest frame.
+    pub max: Duration,
+    /// Rays traced per frame, all kinds.
+    pub rays: u64,
+}
+
+impl SizeBench {
+    /// Millions of rays per second at the median frame time.
+    pub fn mrays_per_s(&self) -> f64 {
+        let s = self.median.as_secs_f64();
+        if s > 0.0 {
+            self.rays as f64 / s / 1e6
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A scene's benchmark: build and frames.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneBench {
+    /// The scene's name.
+    pub scene: String,
+    /// Its acceleration structure, as rebuilt for the measurement (its `build` is the time).
+    pub accel: AccelStats,
+    /// Worker threads rendering the frames.
+    pub threads: usize,
+    /// One entry per requested size, in order.
+    pub sizes: Vec<SizeBench>,
+}
+
+/// Rebuilds `scene`'s acceleration structure once (timed), then renders `runs` frames (at least
+/// one) at each size with the scene's own camera, lights and effects, after one untimed frame.
+pub fn bench_scene(scene: &Scene, sizes: &[(u32, u32)], runs: u32) -> SceneBench {
+    let accel = scene.build_accel(scene.accel_stats().kind).stats();
+    let settings = Stage::Indirect.settings(scene.effects);
+    let runs = runs.max(1);
+    let sizes = sizes
+        .iter()
+        .map(|&(width, height)| {
+            let frame = || {
+                render(
+                    scene,
+                    &scene.camera,
+                    &scene.lights,
+                    &settings,
+                    width,
+                    height,
+                )
+            };
+            let rays = frame().stats.rays.total();
+            let mut times: Vec<Duration> = (0..runs)
+                .map(|_| {
+                    let start = Instant::now();
+                    let f = frame();
+                    let t = start.elapsed();
+                    debug_assert_eq!(f.stats.rays.total(), rays);
+                    t
+                })
+                .collect();
+            times.sort_unstable();
+            SizeBench {
+                width,
+                height,
+                runs,
+                median: median(&times),
+                min: times[0],
+                max: times[times.len() - 1],
+                rays,
+            }
+        })
+        .collect();
+    SceneBench {
+        scene: scene.name.clone(),
+        accel,
+        threads: rayon::current_num_threads(),
+        sizes,
+    }
+}
+
+/// The median of sorted, non-empty times (the mean of the middle two for an even count).
+fn median(sorted: &[Duration]) -> Duration {
+    let n = sorted.len();
+    if n % 2 == 1 {
+        sorted[n / 2]
+    } else {
+        (sorted[n / 2 - 1] + sorted[n / 2]) / 2
+    }
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+impl SceneBench {
+    /// A Markdown report: one line on the structure, a table of frame times.
+    pub fn to_markdown(&self) -> String {
+        let a = &self.accel;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "Scene `{}`: {} triangles, {} ({} nodes, depth {}), built in {:.1} ms; {} threads.\n",
+            self.scene,
+            a.triangles,
+            a.kind.name(),
+            a.nodes,
+            a.depth,
+            ms(a.build),
+            self.threads
+        );
+        s.push_str("| size | runs | median ms | min ms | max ms | rays/frame | M rays/s |\n");
+        s.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+        for z in &self.sizes {
+            let _ = writeln!(
+                s,
+                "| {}×{} | {} | {:.2} | {:.2} | {:.2} | {} | {:.2} |",
+                z.width,
+                z.height,
+                z.runs,
+                ms(z.median),
+                ms(z.min),
+                ms(z.max),
+                z.rays,
+                z.mrays_per_s()
+            );
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cornell_box;
+
+    #[test]
+    fn reports_every_size_with_its_rays() {
+        let b = bench_scene(&cornell_box(), &[(8, 4), (16, 8)], 3);
+        assert_eq!(b.sizes.len(), 2);
+        assert_eq!(b.accel.triangles, 30);
+        for z in &b.sizes {
+            assert_eq!(z.runs, 3);
+            assert!(z.min <= z.median && z.median <= z.max);
+            // One primary ray per pixel, and shadow rays for the lit ones.
+            assert!(z.rays >= u64::from(z.width * z.height));
+        }
+        let md = b.to_markdown();
+        assert!(
+            md.contains("| 8×4 | 3 |") && md.contains("| 16×8 | 3 |"),
+            "{md}"
+        );
+        assert!(md.starts_with("Scene `cornell`: 30 triangles"), "{md}");
+    }
+
+    #[test]
+    fn median_of_odd_and_even_counts() {
+        let d = Duration::from_millis;
+        assert_eq!(median(&[d(1), d(2), d(9)]), d(2));
+        assert_eq!(
+            median(&[d(1), d(3), d(4), d(9)]),
+            Duration::from_micros(3500)
+        );
+    }
+}

@@ -1,0 +1,266 @@
+//! `raytty bench --quick` end to end: the table's shape, the CSV, the SVG plot, the reference
+//! cache, and the README rewrite (only between the markers).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A fresh directory under the system's temporary directory, removed when dropped.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> TempDir {
+        let p = std::env::temp_dir().join(format!("raytty-bench-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&p);
+        std::fs::create_dir_all(&p).expect("a temporary directory");
+        TempDir(p)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn bench(cache: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_raytty"))
+        .arg("bench")
+        .arg("--quick")
+        .args(args)
+        .env("XDG_CACHE_HOME", cache)
+        .output()
+        .expect("raytty runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8(b.to_vec()).expect("UTF-8")
+}
+
+/// Rows per size: 5 seed stages, AA at 4 and 16 spp, GI at 4 bounce counts × the quick ladder
+/// (1 and 4 spp).
+const ROWS_PER_SIZE: usize = 5 + 2 + 4 * 2;
+const SIZES: usize = 2;
+
+#[test]
+fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
+    let dir = TempDir::new("table");
+    let out = bench(&dir.0, &[]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let table: Vec<&str> = stdout.lines().filter(|l| l.starts_with('|')).collect();
+    assert_eq!(table.len(), 2 + SIZES * ROWS_PER_SIZE, "{stdout}");
+    let header: Vec<&str> = table[0]
+        .trim_matches('|')
+        .split('|')
+        .map(str::trim)
+        .collect();
+    assert_eq!(
+        header,
+        [
+            "size",
+            "row",
+            "spp",
+            "bounces",
+            "median ms",
+            "min–max ms",
+            "primary",
+            "shadow",
+            "bounce",
+            "reflection",
+            "M rays/s",
+            "RMSE",
+            "PSNR dB",
+            "ANSI bytes"
+        ]
+    );
+    for row in &table[2..] {
+        let cells: Vec<&str> = row.trim_matches('|').split('|').map(str::trim).collect();
+        assert_eq!(cells.len(), header.len(), "{row}");
+        let rmse: f64 = cells[11].parse().expect("RMSE is a number");
+        assert!(rmse.is_finite() && rmse > 0.0, "{row}");
+        let primary: u64 = cells[6].parse().expect("a count");
+        let spp: u64 = cells[2].parse().expect("spp");
+        let (w, h) = cells[0].split_once('x').expect("WxH");
+        let pixels = w.parse::<u64>().unwrap() * h.parse::<u64>().unwrap();
+        assert_eq!(primary, spp * pixels, "{row}");
+        assert!(cells[13].parse::<u64>().expect("bytes") > pixels, "{row}");
+    }
+    for name in [
+        "flat",
+        "light",
+        "direct",
+        "shadows",
+        "indirect (seed, N = 0.5)",
+    ] {
+        assert_eq!(
+            table
+                .iter()
+                .filter(|l| l.contains(&format!("| {name} |")))
+                .count(),
+            SIZES,
+            "{name}"
+        );
+    }
+    let gi_bounces: Vec<&str> = table
+        .iter()
+        .filter(|l| l.contains("| GI |"))
+        .map(|l| l.split('|').nth(4).unwrap().trim())
+        .collect();
+    for b in ["1", "2", "4", "8"] {
+        assert_eq!(gi_bounces.iter().filter(|&&x| x == b).count(), 2 * SIZES);
+    }
+    // The output says how the reference was made and where it is cached, and it is there.
+    let cache = dir.0.join("raytty");
+    assert!(stdout.contains("rendered in"), "{stdout}");
+    assert!(stdout.contains(&cache.display().to_string()), "{stdout}");
+    assert!(stdout.contains("the seed's constant N = 0.5 at 40x40: RMSE"));
+    let cached = std::fs::read_dir(&cache).expect("the cache").count();
+    assert_eq!(cached, SIZES);
+    // The second run reads it back.
+    let again = bench(&dir.0, &[]);
+    assert!(again.status.success());
+    assert!(text(&again.stdout).contains("read from the cache"));
+    assert!(text(&again.stderr).contains("read from the cache"));
+}
+
+#[test]
+fn csv_has_a_header_and_one_line_per_row() {
+    let dir = TempDir::new("csv");
+    let out = bench(&dir.0, &["--csv"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 1 + SIZES * ROWS_PER_SIZE);
+    let header: Vec<&str> = lines[0].split(',').collect();
+    assert_eq!(header.len(), 16);
+    assert_eq!(header[..3], ["width", "height", "row"]);
+    for line in &lines[1..] {
+        let f: Vec<&str> = line.split(',').collect();
+        assert_eq!(f.len(), 16, "{line}");
+        for (name, v) in header.iter().zip(&f) {
+            if !matches!(*name, "row" | "bounces" | "psnr_db") {
+                assert!(v.parse::<f64>().is_ok(), "{name} = {v} in {line}");
+            }
+        }
+    }
+}
+
+/// Checks that `svg` is well-formed XML as far as this writer goes: every tag closed in order,
+/// attributes quoted, no stray `<` or `&` in text. Returns the element names in order.
+fn elements(svg: &str) -> Vec<String> {
+    let mut stack: Vec<String> = Vec::new();
+    let mut names = Vec::new();
+    let mut rest = svg;
+    while let Some(open) = rest.find('<') {
+        let text = &rest[..open];
+        assert!(!text.contains('>'), "stray > in text {text:?}");
+        for (i, _) in text.match_indices('&') {
+            let t = &text[i..];
+            assert!(
+                ["&amp;", "&lt;", "&gt;"].iter().any(|e| t.starts_with(e)),
+                "bare & in {text:?}"
+            );
+        }
+        let close = rest[open..].find('>').expect("an unclosed tag") + open;
+        let tag = &rest[open + 1..close];
+        assert!(
+            tag.matches('"').count().is_multiple_of(2),
+            "unbalanced quotes in <{tag}>"
+        );
+        if let Some(name) = tag.strip_prefix('/') {
+            assert_eq!(stack.pop().as_deref(), Some(name), "mismatched </{name}>");
+        } else {
+            let name: String = tag
+                .chars()
+                .take_while(|c| !c.is_whitespace() && *c != '/')
+                .collect();
+            names.push(name.clone());
+            if !tag.ends_with('/') {
+                stack.push(name);
+            }
+        }
+        rest = &rest[close + 1..];
+    }
+    assert!(stack.is_empty(), "unclosed {stack:?}");
+    assert!(rest.trim().is_empty());
+    names
+}
+
+#[test]
+fn the_svg_is_well_formed_with_one_polyline_per_bounce_count() {
+    let dir = TempDir::new("svg");
+    let path = dir.0.join("plot.svg");
+    let out = bench(&dir.0, &["--svg", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let svg = std::fs::read_to_string(&path).expect("the SVG was written");
+    assert!(svg.starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\""));
+    let names = elements(&svg);
+    assert_eq!(names[0], "svg");
+    assert_eq!(names.iter().filter(|n| *n == "polyline").count(), 4 * SIZES);
+    for b in [1, 2, 4, 8] {
+        let tag = format!("data-bounces=\"{b}\" points=\"");
+        let lines: Vec<&str> = svg.lines().filter(|l| l.contains(&tag)).collect();
+        assert_eq!(lines.len(), SIZES, "{b} bounces");
+        for l in lines {
+            let points = l.split(&tag).nth(1).unwrap().split('"').next().unwrap();
+            let pts: Vec<&str> = points.split(' ').collect();
+            assert_eq!(pts.len(), 2, "the ladder 1, 4: {l}");
+            for p in pts {
+                let (x, y) = p.split_once(',').expect("x,y");
+                assert!(x.parse::<f64>().unwrap().is_finite());
+                assert!(y.parse::<f64>().unwrap().is_finite());
+            }
+        }
+    }
+    // The seed's stages are points: 5 stages + 2 AA rows per size (+ one legend square each).
+    assert_eq!(svg.matches("class=\"stage\"").count(), 7 * SIZES);
+}
+
+#[test]
+fn the_readme_changes_only_between_the_markers() {
+    let dir = TempDir::new("readme");
+    let path = dir.0.join("README.md");
+    let before = "# raytty\n\nSome text | with a pipe.\n\n## What accuracy costs\n\n\
+                  <!-- bench:start -->\nold table\n<!-- bench:end -->\n\nAfter the table.\n";
+    std::fs::write(&path, before).unwrap();
+    let out = bench(&dir.0, &["--readme", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let after = std::fs::read_to_string(&path).unwrap();
+    let start = "<!-- bench:start -->";
+    let end = "<!-- bench:end -->";
+    let (head, _) = before.split_once(start).unwrap();
+    let (_, tail) = before.split_once(end).unwrap();
+    assert!(after.starts_with(&format!("{head}{start}\n")));
+    assert!(after.ends_with(&format!("\n{end}{tail}")));
+    let inner = &after[head.len() + start.len()..after.len() - tail.len() - end.len()];
+    assert!(!inner.contains("old table"));
+    assert_eq!(
+        inner.lines().filter(|l| l.starts_with('|')).count(),
+        2 + SIZES * ROWS_PER_SIZE
+    );
+    // The table in the README is the one printed.
+    assert_eq!(inner.trim(), text(&out.stdout).trim());
+}
+
+#[test]
+fn a_readme_without_markers_or_a_bad_size_is_a_usage_error() {
+    let dir = TempDir::new("bad");
+    let path = dir.0.join("README.md");
+    std::fs::write(&path, "# no markers\n").unwrap();
+    let out = bench(&dir.0, &["--readme", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("<!-- bench:start -->"));
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "# no markers\n");
+    // Nothing was rendered, so nothing was cached.
+    assert!(!dir.0.join("raytty").exists());
+    for bad in [
+        &["--sizes", "0x10"][..],
+        &["--sizes", "10"],
+        &["--runs", "0"],
+        &["--max-spp", "x"],
+    ] {
+        let out = bench(&dir.0, bad);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+        assert!(!text(&out.stderr).contains("panicked"), "{bad:?}");
+    }
+}

@@ -1,0 +1,318 @@
+//! A frame traces only what its effects call for: the ray counts in `FrameStats`, by kind, for
+//! each effect switched off and on. Counts, not timings, so these hold on any machine.
+
+use glam::Vec3;
+use raytty::{
+    Camera, Effects, FrameStats, HitCache, Image, Indirect, Material, PointLight, Scene,
+    SceneBuilder, Settings, Stage, cornell_box, render, render_cached,
+};
+
+const W: u32 = 48;
+const H: u32 = 36;
+
+fn settings(shadows: bool, indirect: Indirect, samples: u32) -> Settings {
+    let mut s = Stage::Indirect.settings(Effects::SEED);
+    s.effects = Effects {
+        shadows,
+        indirect,
+        samples,
+    };
+    s
+}
+
+fn stats(scene: &Scene, s: &Settings) -> FrameStats {
+    render(scene, &scene.camera, &scene.lights, s, W, H).stats
+}
+
+const GI4: Indirect = Indirect::PathTraced { bounces: 4 };
+
+#[test]
+fn shadows_off_trace_no_shadow_ray() {
+    let scene = cornell_box();
+    for indirect in [Indirect::None, Indirect::Constant(0.5), GI4] {
+        let off = stats(&scene, &settings(false, indirect, 1));
+        assert_eq!(off.rays.shadow, 0, "{indirect:?}");
+        // The control: the same frame with shadows on does trace them.
+        let on = stats(&scene, &settings(true, indirect, 1));
+        assert!(on.rays.shadow > 0, "{indirect:?}");
+    }
+}
+
+#[test]
+fn constant_or_no_indirect_traces_no_bounce_ray() {
+    let scene = cornell_box();
+    for indirect in [Indirect::None, Indirect::Constant(0.5)] {
+        for samples in [1, 4] {
+            let s = stats(&scene, &settings(true, indirect, samples));
+            assert_eq!(s.rays.bounce, 0, "{indirect:?} {samples} spp");
+        }
+    }
+    for stage in [
+        Stage::Flat,
+        Stage::Light,
+        Stage::Direct,
+        Stage::Shadows,
+        Stage::Indirect,
+    ] {
+        let s = stats(&scene, &stage.settings(scene.effects));
+        assert_eq!(s.rays.bounce, 0, "{stage:?}");
+    }
+}
+
+/// A wall facing the camera with the light behind it: every visible point faces away from the
+/// light, so not one shadow ray is worth tracing (even with path-traced bounces, which land on
+/// the same wall's lit-away side or miss).
+#[test]
+fn a_light_behind_every_visible_surface_costs_no_shadow_ray() {
+    let mut b = SceneBuilder::new();
+    let grey = b.material(Material::diffuse(Vec3::splat(0.75)));
+    let (a, bb, c, d) = (
+        Vec3::new(-5.0, -5.0, 1.0),
+        Vec3::new(5.0, -5.0, 1.0),
+        Vec3::new(5.0, 5.0, 1.0),
+        Vec3::new(-5.0, 5.0, 1.0),
+    );
+    b.object([[a, bb, c], [a, c, d]], grey);
+    b.light(PointLight {
+        position: Vec3::new(0.3, -0.2, 2.0),
+        power: Vec3::splat(14.0),
+    });
+    let wall = b
+        .build("wall", Camera::default(), Effects::SEED)
+        .expect("valid");
+    for indirect in [Indirect::Constant(0.5), GI4] {
+        let s = stats(&wall, &settings(true, indirect, 1));
+        assert_eq!(s.rays.primary, u64::from(W * H));
+        assert_eq!(s.rays.shadow, 0, "{indirect:?}");
+    }
+    // The control: the light moved in front of the wall casts shadow rays from every pixel.
+    let mut front = wall.lights.clone();
+    front[0].position.z = 0.0;
+    let s = render(
+        &wall,
+        &wall.camera,
+        &front,
+        &settings(true, Indirect::Constant(0.5), 1),
+        W,
+        H,
+    )
+    .stats;
+    assert_eq!(s.rays.shadow, u64::from(W * H));
+}
+
+#[test]
+fn a_light_only_change_traces_no_primary_ray() {
+    let scene = cornell_box();
+    let mut cache = HitCache::new();
+    let s = scene.effects;
+    for stage in [Stage::Shadows, Stage::Indirect, Stage::Gi] {
+        let settings = stage.settings(s);
+        let first = render_cached(
+            &scene,
+            &scene.camera,
+            &scene.lights,
+            &settings,
+            W,
+            H,
+            &mut cache,
+        );
+        assert_eq!(first.stats.rays.primary, u64::from(W * H), "{stage:?}");
+        let mut moved = scene.lights.clone();
+        moved[0].position += Vec3::new(0.2, 0.1, -0.1);
+        let second = render_cached(&scene, &scene.camera, &moved, &settings, W, H, &mut cache);
+        assert_eq!(second.stats.rays.primary, 0, "{stage:?}");
+        assert!(second.stats.rays.shadow > 0, "{stage:?}");
+        // Reusing the hits changes no pixel.
+        let fresh = render(&scene, &scene.camera, &moved, &settings, W, H);
+        assert_eq!(second.image, fresh.image, "{stage:?}");
+        cache.clear();
+    }
+}
+
+#[test]
+fn no_mirrors_no_reflection_ray() {
+    let scene = cornell_box();
+    assert!(!scene.has_mirrors());
+    for stage in Stage::ALL {
+        let s = stats(&scene, &stage.settings(scene.effects));
+        assert_eq!(s.rays.reflection, 0, "{stage:?}");
+    }
+    let s = stats(&scene, &settings(true, GI4, 4));
+    assert_eq!(s.rays.reflection, 0);
+
+    // The control: the same box with a mirror back wall reflects.
+    let mirror = mirrored_box();
+    assert!(mirror.has_mirrors());
+    let s = stats(&mirror, &Stage::Indirect.settings(mirror.effects));
+    assert!(s.rays.reflection > 0);
+}
+
+/// The Cornell box's walls again, with a perfect mirror facing the camera.
+fn mirrored_box() -> Scene {
+    let mut b = SceneBuilder::new();
+    let white = b.material(Material::diffuse(Vec3::splat(0.75)));
+    let glass = b.material(Material {
+        colour: Vec3::splat(0.75),
+        mirror: 1.0,
+    });
+    let v = |x, y, z| Vec3::new(x, y, z);
+    b.object(
+        [
+            [v(-1., -1., 1.), v(1., -1., 1.), v(1., 1., 1.)],
+            [v(-1., -1., 1.), v(1., 1., 1.), v(-1., 1., 1.)],
+        ],
+        glass,
+    );
+    b.object(
+        [
+            [v(-1., 1., -1.), v(1., 1., -1.), v(1., 1., 1.)],
+            [v(-1., 1., -1.), v(1., 1., 1.), v(-1., 1., 1.)],
+        ],
+        white,
+    );
+    b.light(PointLight {
+        position: v(0.0, -0.5, 0.0),
+        power: Vec3::splat(14.0),
+    });
+    b.build("mirror", Camera::default(), Effects::SEED)
+        .expect("valid")
+}
+
+#[test]
+fn gi_with_b_bounces_traces_at_most_b_bounce_rays_per_path() {
+    let scene = cornell_box();
+    for bounces in [1, 2, 4, 8] {
+        for samples in [1, 4] {
+            let s = stats(
+                &scene,
+                &settings(true, Indirect::PathTraced { bounces }, samples),
+            );
+            let paths = s.rays.primary;
+            assert_eq!(paths, u64::from(W * H * samples));
+            assert!(s.rays.bounce > 0, "{bounces} bounces");
+            assert!(
+                s.rays.bounce <= u64::from(bounces) * paths,
+                "{bounces} bounces: {} bounce rays for {paths} paths",
+                s.rays.bounce
+            );
+            // Every bounce that hits does next-event estimation: more shadow rays than with
+            // direct light alone.
+            let direct = stats(&scene, &settings(true, Indirect::None, samples));
+            assert!(s.rays.shadow > direct.rays.shadow, "{bounces} bounces");
+        }
+    }
+    // One bounce: every primary hit sends exactly one bounce ray (nothing ends a path before
+    // its first bounce) and a miss sends none. The flat stage shows which pixels hit.
+    let flat = render(
+        &scene,
+        &scene.camera,
+        &scene.lights,
+        &Stage::Flat.settings(scene.effects),
+        W,
+        H,
+    );
+    let hits = flat
+        .image
+        .pixels
+        .iter()
+        .filter(|p| **p != Vec3::ZERO)
+        .count() as u64;
+    assert!(hits > 0 && hits < u64::from(W * H), "{hits} hits");
+    let s = stats(
+        &scene,
+        &settings(true, Indirect::PathTraced { bounces: 1 }, 1),
+    );
+    assert_eq!(s.rays.bounce, hits);
+}
+
+#[test]
+fn n_samples_per_pixel_trace_n_w_h_primary_rays() {
+    let scene = cornell_box();
+    for samples in [1, 2, 3, 4, 9, 16] {
+        for indirect in [Indirect::Constant(0.5), GI4] {
+            let s = stats(&scene, &settings(true, indirect, samples));
+            assert_eq!(s.samples, samples);
+            assert_eq!(s.rays.primary, u64::from(samples * W * H), "{samples} spp");
+        }
+    }
+}
+
+fn mean(img: &Image) -> Vec3 {
+    img.pixels.iter().copied().sum::<Vec3>() / img.pixels.len() as f32
+}
+
+/// GI is direct light plus what the bounces bring, never less: at one sample (the same primary
+/// hits as the direct-only frame) every pixel is at least its direct value, and the mean of
+/// what GI adds is the same at 1 and 16 samples (both estimate one expectation).
+#[test]
+fn gi_is_direct_light_plus_something() {
+    let scene = cornell_box();
+    let direct = render(
+        &scene,
+        &scene.camera,
+        &scene.lights,
+        &settings(true, Indirect::None, 1),
+        W,
+        H,
+    )
+    .image;
+    let gi = |samples| {
+        render(
+            &scene,
+            &scene.camera,
+            &scene.lights,
+            &settings(true, Indirect::PathTraced { bounces: 8 }, samples),
+            W,
+            H,
+        )
+        .image
+    };
+    let gi1 = gi(1);
+    for (i, (g, d)) in gi1.pixels.iter().zip(&direct.pixels).enumerate() {
+        assert!(g.cmpge(*d).all(), "pixel {i}: GI {g} < direct {d}");
+    }
+    let added1 = mean(&gi1) - mean(&direct);
+    assert!(
+        added1.min_element() > 0.05 * mean(&direct).max_element(),
+        "GI adds only {added1}"
+    );
+    let direct16 = render(
+        &scene,
+        &scene.camera,
+        &scene.lights,
+        &settings(true, Indirect::None, 16),
+        W,
+        H,
+    )
+    .image;
+    let added16 = mean(&gi(16)) - mean(&direct16);
+    let rel = (added16 - added1).abs() / added16;
+    assert!(
+        rel.max_element() < 0.05,
+        "what GI adds: {added1} at 1 spp, {added16} at 16"
+    );
+}
+
+#[test]
+fn gi_is_the_same_with_one_thread_and_two() {
+    let scene = cornell_box();
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool")
+            .install(|| {
+                render(
+                    &scene,
+                    &scene.camera,
+                    &scene.lights,
+                    &settings(true, Indirect::PathTraced { bounces: 8 }, 4),
+                    W,
+                    H,
+                )
+            })
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one.image, two.image);
+    assert_eq!(one.stats.rays, two.stats.rays);
+}
