@@ -161,6 +161,8 @@ struct Tally {
     loaded: u64,
     errors: u64,
     slowest: Duration,
+    /// The input that took longest (to replay it: the same seed, this many iterations + 1).
+    slowest_input: String,
 }
 
 /// Loads `scene` (with `mesh` as the mesh file) and checks the outcome; panics on a finding.
@@ -198,7 +200,10 @@ fn check(scene: &str, mesh: &[u8], tally: &mut Tally) {
         }
     }
     tally.inputs += 1;
-    tally.slowest = tally.slowest.max(start.elapsed());
+    if start.elapsed() > tally.slowest {
+        tally.slowest = start.elapsed();
+        tally.slowest_input = scene.chars().take(4000).collect();
+    }
 }
 
 /// An error has a line and a column, a message, and no control characters.
@@ -296,4 +301,5 @@ fn long_run() {
         t.errors,
         t.slowest
     );
+    eprintln!("the slowest input:\n{}", t.slowest_input);
 }
