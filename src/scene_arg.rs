@@ -16,7 +16,17 @@ pub fn load_scene(arg: Option<&str>) -> Result<Scene> {
     };
     let path = Path::new(arg);
     if path.exists() || arg.ends_with(".toml") {
-        return scenefile::load(path).map_err(|e| UsageError(e.to_string()).into());
+        return scenefile::load(path).map_err(|e| {
+            let hint = if path.exists() {
+                String::new()
+            } else {
+                format!(
+                    "; give the path of a scene file, or a built-in scene: {}",
+                    builtin::names().join(", ")
+                )
+            };
+            UsageError(format!("{e}{hint}")).into()
+        });
     }
     match builtin::find(arg) {
         Some(b) => b.load().map_err(|e| UsageError(e.to_string()).into()),
