@@ -3,7 +3,7 @@
 //! [`SceneFileError`] naming the file, line and column, what was wrong and what would be right.
 //! `scenes/example.toml` documents every key.
 //!
-//! A file that loads is a valid [`Scene`]: it goes through [`SceneBuilder`], and everything the
+//! A file that loads is a valid [`Scene`]: it goes through [`SceneBuilder`](crate::SceneBuilder), and everything the
 //! builder would reject (degenerate triangles, bad lights) is caught first, here, with a line.
 
 mod build;
