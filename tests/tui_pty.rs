@@ -335,3 +335,17 @@ fn the_app_shows_the_scene_given_with_scene() {
     s.send(b"\x03");
     assert!(s.finish().success());
 }
+
+#[test]
+fn a_bad_scene_is_refused_before_the_terminal_is_touched() {
+    let mut s = Session::start_with(100, 10, false, &["--scene", "no-such-scene"]);
+    let status = s.finish();
+    assert_eq!(status.exit_code(), 2);
+    let screen = s.screen.screen();
+    assert!(!screen.alternate_screen() && !screen.hide_cursor());
+    let text = screen.contents();
+    assert!(
+        text.contains("no-such-scene") && text.contains("cornell, mirror, lights, sphere"),
+        "{text}"
+    );
+}

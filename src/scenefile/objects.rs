@@ -9,7 +9,6 @@ use super::check::Ctx;
 use super::error::{SceneFileError, did_you_mean};
 use super::spec::{NumberOrTriple, ObjectSpec};
 use super::*;
-use crate::frame::printable;
 use crate::geometry::Triangle;
 use crate::obj::parse_obj;
 use crate::procedural::{displaced_icosphere, icosphere_triangles};
@@ -73,15 +72,16 @@ pub fn object_triangles(
     Err(match origins {
         Origins::Each(offsets) => cx.err(offsets[i], problem),
         Origins::Object(offset) => cx.err(offset, problem),
-        Origins::Mesh(file, faces) => SceneFileError {
-            file: printable(&file),
-            line: faces[i].0 as usize,
-            column: faces[i].1 as usize,
-            message: printable(&format!(
+        Origins::Mesh(file, faces) => SceneFileError::at_line(
+            &file,
+            "",
+            faces[i].0 as usize,
+            faces[i].1 as usize,
+            format!(
                 "{problem} (after the transform of the object at {})",
                 cx.place(at)
-            )),
-        },
+            ),
+        ),
     })
 }
 
@@ -209,15 +209,18 @@ fn mesh(
             format!("{e}; give the path of an OBJ file, relative to the scene file's folder"),
         )
     })?;
-    let mesh = parse_obj(&bytes, budget, MAX_MESH_VERTICES).map_err(|e| SceneFileError {
-        file: printable(&shown),
-        line: e.line,
-        column: e.column,
-        message: printable(&format!(
-            "{} (in the mesh named at {})",
-            e.message,
-            cx.place(path.span().start)
-        )),
+    let mesh = parse_obj(&bytes, budget, MAX_MESH_VERTICES).map_err(|e| {
+        SceneFileError::at_line(
+            &shown,
+            &String::from_utf8_lossy(&bytes),
+            e.line,
+            e.column,
+            format!(
+                "{} (in the mesh named at {})",
+                e.message,
+                cx.place(path.span().start)
+            ),
+        )
     })?;
     if mesh.triangles.is_empty() {
         return Err(cx.err_at(
