@@ -109,6 +109,14 @@ fn bad_values_get_a_clear_message_and_status_2() {
             ],
             "limit",
         ),
+        (
+            &["render", "--size", "65535x65535"],
+            "--size 65535x65535 is 65535x131070 = ",
+        ),
+        (
+            &["render", "-o", "/nonexistent/box.jpg"],
+            "cannot write .jpg",
+        ),
     ] {
         let out = raytty(args);
         let err = String::from_utf8_lossy(&out.stderr);
@@ -116,4 +124,28 @@ fn bad_values_get_a_clear_message_and_status_2() {
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
+}
+
+#[test]
+fn no_color_makes_the_default_text_format_ascii() {
+    let run = |no_color: bool, args: &[&str]| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_raytty"));
+        cmd.args(["render", "--size", "12x4"]).args(args);
+        if no_color {
+            cmd.env("NO_COLOR", "1");
+        } else {
+            cmd.env_remove("NO_COLOR");
+        }
+        let out = cmd.output().unwrap();
+        assert!(out.status.success());
+        String::from_utf8(out.stdout).unwrap()
+    };
+    assert!(run(false, &[]).contains("\x1b[38;2;"));
+    let plain = run(true, &[]);
+    assert!(
+        !plain.contains('\x1b') && plain.lines().count() == 4,
+        "{plain:?}"
+    );
+    // An explicit --format still wins.
+    assert!(run(true, &["--format", "ansi"]).contains("\x1b[38;2;"));
 }
