@@ -117,6 +117,15 @@ fn bad_values_get_a_clear_message_and_status_2() {
             &["render", "-o", "/nonexistent/box.jpg"],
             "cannot write .jpg",
         ),
+        (
+            &["--scene", "/nonexistent/box.toml", "render"],
+            "--scene /nonexistent/box.toml: no such file: give the path of an existing .toml",
+        ),
+        (&["--scene", "/", "render"], "--scene /: is a folder"),
+        (
+            &["--scene", "Cornell", "render"],
+            "name; did you mean `cornell`? (built-in scenes: cornell, ",
+        ),
     ] {
         let out = raytty(args);
         let err = String::from_utf8_lossy(&out.stderr);
