@@ -135,6 +135,10 @@ struct RenderArgs {
     /// Shading stage: flat, light, direct, shadows, indirect (the default) or gi.
     #[arg(long, value_parser = parse_stage, default_value = "indirect")]
     stage: Stage,
+    /// Samples per pixel, 1 to 1024, spread over the pixel: smooth edges, and far less noise
+    /// in the gi stage (one sample is noisy). Default: the scene's (1 for gi).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    samples: Option<u32>,
     /// Camera position and yaw in degrees, x,y,z,yaw (default: the scene's camera).
     #[arg(long, value_name = "X,Y,Z,YAW", value_parser = parse_camera, allow_hyphen_values = true)]
     camera: Option<[f32; 4]>,
@@ -340,6 +344,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
                 ColorMode::Ascii => Format::Ascii,
             }),
             stage: Stage::Indirect,
+            samples: None,
             camera: None,
             light: None,
             output: None,
@@ -396,7 +401,10 @@ fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
         camera.yaw = yaw.to_radians();
     }
     let lights = lights_with(&scene, args.light);
-    let settings = args.stage.settings(scene.effects);
+    let mut settings = args.stage.settings(scene.effects);
+    if let Some(n) = args.samples {
+        settings.effects.samples = n;
+    }
     let frame = render(&scene, &camera, &lights, &settings, w, h);
 
     let mut out: Box<dyn Write> = match &args.output {

@@ -158,3 +158,48 @@ fn no_color_makes_the_default_text_format_ascii() {
     // An explicit --format still wins.
     assert!(run(true, &["--format", "ansi"]).contains("\x1b[38;2;"));
 }
+
+/// The PFM `raytty render --stage gi --samples n` writes, as linear floats.
+fn gi_pixels(samples: &str) -> Vec<f32> {
+    let out = raytty(&[
+        "render",
+        "--stage",
+        "gi",
+        "--pixels",
+        "24x24",
+        "--format",
+        "pfm",
+        "--samples",
+        samples,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let header = "PF\n24 24\n-1.0\n".len();
+    out.stdout[header..]
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect()
+}
+
+#[test]
+fn samples_make_the_gi_stage_converge() {
+    let reference = gi_pixels("256");
+    let error = |samples: &str| -> f32 {
+        let p = gi_pixels(samples);
+        p.iter()
+            .zip(&reference)
+            .map(|(a, b)| (a - b).abs())
+            .sum::<f32>()
+            / p.len() as f32
+    };
+    let (one, sixteen) = (error("1"), error("16"));
+    assert!(
+        sixteen < one / 2.0,
+        "16 samples ({sixteen}) are not much closer to 256 than 1 sample ({one})"
+    );
+    let out = raytty(&["render", "--samples", "0"]);
+    assert_eq!(out.status.code(), Some(2));
+}
