@@ -166,16 +166,47 @@ impl Bvh {
         &self.nodes[i >> 1].0[i & 1]
     }
 
+    /// Every node (the root, then the pairs; not the root pair's filler).
+    fn all_nodes(&self) -> impl Iterator<Item = &Node> {
+        self.nodes
+            .iter()
+            .flat_map(|p| &p.0)
+            .enumerate()
+            .filter(|&(i, _)| i != 1)
+            .map(|(_, n)| n)
+    }
+
     /// Number of levels (0 when empty, 1 for a single leaf).
     pub fn depth(&self) -> u32 {
         self.depth
     }
 
+    /// The tree's SAH cost: the expected number of box-pair and triangle tests for a random
+    /// ray that meets the root box (each node weighted by its area over the root's). Lower is
+    /// better; compare builds of one scene with it.
+    pub fn sah_cost(&self) -> f64 {
+        let area = |n: &Node| {
+            let d = (n.max - n.min).as_dvec3();
+            2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
+        };
+        let Some(NodePair([root, _])) = self.nodes.first() else {
+            return 0.0;
+        };
+        let root_area = area(root);
+        if !(root_area > 0.0) {
+            return 0.0;
+        }
+        self.all_nodes()
+            .map(|n| {
+                let work = if n.is_leaf() { f64::from(n.count) } else { 1.0 };
+                work * area(n) / root_area
+            })
+            .sum()
+    }
+
     /// Number of leaves.
     pub fn leaves(&self) -> usize {
-        (0..self.nodes())
-            .filter(|&i| self.node(i).is_leaf())
-            .count()
+        self.all_nodes().filter(|n| n.is_leaf()).count()
     }
 
     /// The closest hit with `t < t_max` (ties go to the lowest scene index), or `None`.

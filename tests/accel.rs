@@ -339,6 +339,10 @@ fn leaves_hold_a_few_triangles() {
         (1.0..=raytty::bvh::LEAF_MAX as f64).contains(&per_leaf),
         "{per_leaf} triangles per leaf"
     );
+    // A binary tree: one more leaf than interior nodes.
+    assert_eq!(bvh.nodes(), 2 * bvh.leaves() - 1);
+    let cost = bvh.sah_cost();
+    assert!(cost.is_finite() && cost > 1.0, "SAH cost {cost}");
     // A well-balanced tree over 18000 triangles is a few dozen levels at most.
     assert!(bvh.depth() < 40, "depth {}", bvh.depth());
 }

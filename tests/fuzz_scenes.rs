@@ -4,8 +4,9 @@
 //! a scene that renders a finite frame, or fail with an error that has a line and column. No
 //! input may panic, and none is larger than [`MAX_INPUT`] bytes, so none can take long.
 //!
-//! `cargo test` runs the regression corpus in `tests/fuzz_corpus/` (inputs the fuzzer once
-//! found interesting) and a short run; the long run is ignored:
+//! `cargo test` runs the regression corpus in `tests/fuzz_corpus/` (hostile inputs: files
+//! named `ok_*.toml` must load, every other `.toml` must be refused with a position) and a
+//! short run; the long run is ignored:
 //!
 //!     RAYTTY_FUZZ_ITERATIONS=200000 RAYTTY_FUZZ_SEED=1 cargo test --test fuzz_scenes -- --ignored
 
@@ -160,6 +161,8 @@ struct Tally {
     loaded: u64,
     errors: u64,
     slowest: Duration,
+    /// The input that took longest (to replay it: the same seed, this many iterations + 1).
+    slowest_input: String,
 }
 
 /// Loads `scene` (with `mesh` as the mesh file) and checks the outcome; panics on a finding.
@@ -197,7 +200,10 @@ fn check(scene: &str, mesh: &[u8], tally: &mut Tally) {
         }
     }
     tally.inputs += 1;
-    tally.slowest = tally.slowest.max(start.elapsed());
+    if start.elapsed() > tally.slowest {
+        tally.slowest = start.elapsed();
+        tally.slowest_input = scene.chars().take(4000).collect();
+    }
 }
 
 /// An error has a line and a column, a message, and no control characters.
@@ -246,9 +252,17 @@ fn regression_corpus() {
             n += 1;
             let source = String::from_utf8_lossy(&std::fs::read(&path).unwrap()).into_owned();
             let outcome = catch_unwind(|| scenefile::load(&path));
+            let must_load = path
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("ok_");
             match outcome.unwrap_or_else(|_| panic!("{} panics", path.display())) {
-                Ok(_) => {}
-                Err(e) => positioned(&e, &source),
+                Ok(_) => assert!(must_load, "{} loads", path.display()),
+                Err(e) => {
+                    assert!(!must_load, "{}: {e}", path.display());
+                    positioned(&e, &source);
+                }
             }
         }
     }
@@ -287,4 +301,5 @@ fn long_run() {
         t.errors,
         t.slowest
     );
+    eprintln!("the slowest input:\n{}", t.slowest_input);
 }

@@ -223,6 +223,9 @@ enum Split {
     Binned(Binning, usize),
     /// Sort by centroid along the axis (ties by scene index) and cut at this many.
     Sorted(usize, usize),
+    /// Put the entries in this order (a small node's, sorted along the chosen axis) and cut at
+    /// this many.
+    Ordered([u8; SMALL_NODE], usize),
     /// All centroids coincide: cut the list in two as it is.
     Halve,
 }
@@ -399,17 +402,17 @@ fn split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32) -> Option<usize> {
             partition(refs, |r| binning.bin(r.min * 0.5 + r.max * 0.5) < bin)
         }
         Split::Sorted(axis, mid) => {
-            let key = |r: &PrimRef| (r.centroid(axis), r.id);
-            if n <= SMALL_NODE {
-                refs.sort_unstable_by(|a, b| {
-                    let (a, b) = (key(a), key(b));
-                    a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
-                });
-            } else {
-                refs.select_nth_unstable_by(mid, |a, b| {
-                    let (a, b) = (key(a), key(b));
-                    a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
-                });
+            refs.select_nth_unstable_by(mid, |a, b| {
+                a.centroid(axis)
+                    .total_cmp(&b.centroid(axis))
+                    .then(a.id.cmp(&b.id))
+            });
+            mid
+        }
+        Split::Ordered(order, mid) => {
+            let old: [PrimRef; SMALL_NODE] = std::array::from_fn(|i| refs[i.min(n - 1)]);
+            for (r, &o) in refs.iter_mut().zip(&order[..n]) {
+                *r = old[o as usize];
             }
             mid
         }
@@ -420,7 +423,7 @@ fn split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32) -> Option<usize> {
 }
 
 /// Picks how to split a node of `refs.len()` triangles with bounds `nb`.
-fn choose_split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32) -> Split {
+fn choose_split(refs: &[PrimRef], nb: &NodeBounds, depth: u32) -> Split {
     let n = refs.len();
     if n == 1 {
         return Split::Leaf;
@@ -507,40 +510,51 @@ fn binned_sah(refs: &[PrimRef], c: &Bounds) -> (Option<f64>, Option<Split>) {
     }
 }
 
-/// The exact SAH for a small node: every cut between centroids sorted along each axis.
-fn small_sah(refs: &mut [PrimRef], c: &Bounds) -> (Option<f64>, Option<Split>) {
+/// The exact SAH for a small node: every cut between centroids sorted along each axis (ties
+/// by scene index).
+#[allow(clippy::needless_range_loop)] // `axis` picks a coordinate of several arrays' entries
+fn small_sah(refs: &[PrimRef], c: &Bounds) -> (Option<f64>, Option<Split>) {
     let n = refs.len();
-    let mut best: Option<(f64, usize, usize)> = None;
+    debug_assert!(n <= SMALL_NODE);
+    let centroids: [Vec3; SMALL_NODE] = std::array::from_fn(|i| {
+        refs.get(i)
+            .map_or(Vec3::ZERO, |r| r.min * 0.5 + r.max * 0.5)
+    });
+    let mut best: Option<(f64, [u8; SMALL_NODE], usize)> = None;
     let mut right_cost = [0f64; SMALL_NODE];
     for axis in 0..3 {
         if !(c.max[axis] > c.min[axis]) {
             continue;
         }
-        refs.sort_unstable_by(|a, b| {
-            a.centroid(axis)
-                .total_cmp(&b.centroid(axis))
-                .then(a.id.cmp(&b.id))
+        let mut order: [u8; SMALL_NODE] = std::array::from_fn(|i| i as u8);
+        order[..n].sort_unstable_by(|&a, &b| {
+            let (a, b) = (a as usize, b as usize);
+            centroids[a][axis]
+                .total_cmp(&centroids[b][axis])
+                .then(refs[a].id.cmp(&refs[b].id))
         });
         let mut acc = Bounds::EMPTY;
         for k in (1..n).rev() {
-            acc.grow(refs[k].min, refs[k].max);
+            let r = &refs[order[k] as usize];
+            acc.grow(r.min, r.max);
             right_cost[k] = acc.area() * (n - k) as f64;
         }
         let mut acc = Bounds::EMPTY;
         for k in 1..n {
-            acc.grow(refs[k - 1].min, refs[k - 1].max);
-            // Cut only between distinct centroids, so the halves' centroid boxes shrink.
-            if refs[k - 1].centroid(axis) == refs[k].centroid(axis) {
+            let (prev, next) = (order[k - 1] as usize, order[k] as usize);
+            acc.grow(refs[prev].min, refs[prev].max);
+            // Cut only between distinct centroids, so each half's centroid box shrinks.
+            if centroids[prev][axis] == centroids[next][axis] {
                 continue;
             }
             let cost = acc.area() * k as f64 + right_cost[k];
             if best.is_none_or(|(c, _, _)| cost < c) {
-                best = Some((cost, axis, k));
+                best = Some((cost, order, k));
             }
         }
     }
     match best {
-        Some((cost, axis, k)) => (Some(cost), Some(Split::Sorted(axis, k))),
+        Some((cost, order, k)) => (Some(cost), Some(Split::Ordered(order, k))),
         None => (None, None),
     }
 }
