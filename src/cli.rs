@@ -328,7 +328,20 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
     #[cfg(feature = "tui")]
     if io::stdout().is_terminal() {
         if !dumb {
-            return crate::tui::run(crate::scene_arg::load_scene(scene)?, color);
+            // A big scene takes seconds to generate and build: say so rather than show a
+            // blank terminal, then erase the line before the app (or an error) takes over.
+            let note = io::stderr().is_terminal();
+            if note {
+                eprint!(
+                    "raytty: loading {}…",
+                    raytty::printable(scene.unwrap_or("the Cornell box"))
+                );
+            }
+            let loaded = crate::scene_arg::load_scene(scene);
+            if note {
+                eprint!("\r\x1b[2K");
+            }
+            return crate::tui::run(loaded?, color);
         }
         eprintln!("raytty: TERM=dumb cannot run the app (it moves the cursor): one frame follows");
     }

@@ -348,6 +348,23 @@ fn the_app_shows_the_scene_given_with_scene() {
 }
 
 #[test]
+fn the_loading_note_is_erased_when_the_app_ends_and_before_an_error() {
+    let mut s = Session::start(60, 10, false);
+    s.wait_for_status(&["indirect"]);
+    s.send(b"\x1b");
+    assert!(s.finish().success());
+    let shown = s.screen.screen().contents();
+    assert!(!shown.contains("loading"), "{shown}");
+    let mut s = Session::start_with(100, 10, false, &["--scene", "no-such-scene"]);
+    assert_eq!(s.finish().exit_code(), 2);
+    let shown = s.screen.screen().contents();
+    assert!(
+        shown.starts_with("raytty: --scene no-such-scene"),
+        "{shown}"
+    );
+}
+
+#[test]
 fn a_dumb_terminal_gets_one_frame_not_the_app() {
     let mut s = Session::start_term(100, 40, false, &[], "dumb");
     let status = s.finish();
