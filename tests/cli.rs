@@ -123,6 +123,10 @@ fn bad_values_get_a_clear_message_and_status_2() {
         ),
         (&["--scene", "/", "render"], "--scene /: is a folder"),
         (
+            &["--scene", "scenes/tetrahedron.obj", "render"],
+            "an OBJ mesh is not a scene: write a .toml scene with an [[object]] of kind = \"obj\" and path = \"tetrahedron.obj\"",
+        ),
+        (
             &["--scene", "Cornell", "render"],
             "name; did you mean `cornell`? (built-in scenes: cornell, ",
         ),
