@@ -207,3 +207,22 @@ fn samples_make_the_gi_stage_converge() {
     let out = raytty(&["render", "--samples", "0"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn output_failures_are_one_line_with_status_1() {
+    for (args, needle) in [
+        (
+            &["render", "-o", "/nonexistent/box.png"][..],
+            "raytty: cannot create /nonexistent/box.png: No such file or directory\n",
+        ),
+        (
+            &["render", "-o", "/dev/full"],
+            "raytty: cannot write to /dev/full: No space left on device\n",
+        ),
+    ] {
+        let out = raytty(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(err, needle, "{args:?}");
+    }
+}
