@@ -236,7 +236,7 @@ pub fn main() -> ExitCode {
         Ok(code) => code,
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("raytty: {e:#}");
+            eprintln!("raytty: {}", without_os_error(&format!("{e:#}")));
             ExitCode::from(if e.downcast_ref::<UsageError>().is_some() {
                 2
             } else {
@@ -418,28 +418,54 @@ fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
     if let Some(n) = args.samples {
         settings.effects.samples = n;
     }
-    let frame = render(&scene, &camera, &lights, &settings, w, h);
-
+    // The output file is created before the (maybe long) render, so a bad path fails at once.
     let mut out: Box<dyn Write> = match &args.output {
         Some(path) => Box::new(BufWriter::new(
             File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
         )),
         None => Box::new(BufWriter::new(io::stdout().lock())),
     };
-    match format {
-        Format::Png => frame.image.write_png(&mut out)?,
-        Format::Pfm => frame.image.write_pfm(&mut out)?,
+    let frame = render(&scene, &camera, &lights, &settings, w, h);
+    let written = match format {
+        Format::Png => frame.image.write_png(&mut out),
+        Format::Pfm => frame.image.write_pfm(&mut out),
         Format::Ansi | Format::Ansi256 | Format::Ascii => {
             let mode = match format {
                 Format::Ansi => ColorMode::TrueColor,
                 Format::Ansi256 => ColorMode::Ansi256,
                 _ => ColorMode::Ascii,
             };
-            out.write_all(&encode_text(&CellGrid::from_image(&frame.image, mode)))?;
+            out.write_all(&encode_text(&CellGrid::from_image(&frame.image, mode)))
+        }
+    };
+    written.and_then(|()| out.flush()).with_context(|| {
+        format!(
+            "cannot write to {}",
+            args.output
+                .as_ref()
+                .map_or_else(|| "stdout".to_string(), |p| p.display().to_string())
+        )
+    })
+}
+
+/// `message` without the " (os error N)" that Rust's I/O errors end with: the words before it
+/// say it all, and the number means nothing to a user.
+fn without_os_error(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(i) = rest.find(" (os error ") {
+        let after = &rest[i + " (os error ".len()..];
+        let digits = after.chars().take_while(char::is_ascii_digit).count();
+        if digits > 0 && after[digits..].starts_with(')') {
+            out.push_str(&rest[..i]);
+            rest = &after[digits + 1..];
+        } else {
+            out.push_str(&rest[..i + 1]);
+            rest = &rest[i + 1..];
         }
     }
-    out.flush()?;
-    Ok(())
+    out.push_str(rest);
+    out
 }
 
 /// The format an output file's extension implies: `.png` and `.pfm` are images, anything else
@@ -501,6 +527,16 @@ mod tests {
         assert_eq!(unwritable_image_extension(Path::new("frame.txt")), None);
         assert_eq!(unwritable_image_extension(Path::new("frame")), None);
         assert_eq!(format_name(Format::Png), "png");
+    }
+
+    #[test]
+    fn os_error_numbers_are_dropped_from_messages() {
+        assert_eq!(
+            without_os_error("cannot create x: No such file or directory (os error 2)"),
+            "cannot create x: No such file or directory"
+        );
+        assert_eq!(without_os_error("a (os error 2); b (os error 28)"), "a; b");
+        assert_eq!(without_os_error("kept (os error x)"), "kept (os error x)");
     }
 
     #[test]

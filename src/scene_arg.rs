@@ -30,6 +30,17 @@ pub fn load_scene(arg: Option<&str>) -> Result<Scene> {
             builtins()
         )));
     }
+    if arg.to_ascii_lowercase().ends_with(".obj") {
+        bail!(UsageError(format!(
+            "--scene {}: an OBJ mesh is not a scene: write a .toml scene with an [[object]] of kind = \"obj\" and path = \"{}\" (scenes/example.toml shows one)",
+            printable(arg),
+            printable(
+                &path
+                    .file_name()
+                    .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+            )
+        )));
+    }
     if path.exists() {
         return scenefile::load(path).map_err(|e| UsageError(e.to_string()).into());
     }

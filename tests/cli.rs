@@ -123,6 +123,10 @@ fn bad_values_get_a_clear_message_and_status_2() {
         ),
         (&["--scene", "/", "render"], "--scene /: is a folder"),
         (
+            &["--scene", "scenes/tetrahedron.obj", "render"],
+            "an OBJ mesh is not a scene: write a .toml scene with an [[object]] of kind = \"obj\" and path = \"tetrahedron.obj\"",
+        ),
+        (
             &["--scene", "Cornell", "render"],
             "name; did you mean `cornell`? (built-in scenes: cornell, ",
         ),
@@ -202,4 +206,23 @@ fn samples_make_the_gi_stage_converge() {
     );
     let out = raytty(&["render", "--samples", "0"]);
     assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn output_failures_are_one_line_with_status_1() {
+    for (args, needle) in [
+        (
+            &["render", "-o", "/nonexistent/box.png"][..],
+            "raytty: cannot create /nonexistent/box.png: No such file or directory\n",
+        ),
+        (
+            &["render", "-o", "/dev/full"],
+            "raytty: cannot write to /dev/full: No space left on device\n",
+        ),
+    ] {
+        let out = raytty(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(err, needle, "{args:?}");
+    }
 }
