@@ -62,7 +62,7 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
             "spp",
             "bounces",
             "median ms",
-            "min–max ms",
+            "min–max ms (runs)",
             "primary",
             "shadow",
             "bounce",
@@ -132,11 +132,11 @@ fn csv_has_a_header_and_one_line_per_row() {
     let lines: Vec<&str> = stdout.lines().collect();
     assert_eq!(lines.len(), 1 + SIZES * ROWS_PER_SIZE);
     let header: Vec<&str> = lines[0].split(',').collect();
-    assert_eq!(header.len(), 16);
+    assert_eq!(header.len(), 17);
     assert_eq!(header[..3], ["width", "height", "row"]);
     for line in &lines[1..] {
         let f: Vec<&str> = line.split(',').collect();
-        assert_eq!(f.len(), 16, "{line}");
+        assert_eq!(f.len(), 17, "{line}");
         for (name, v) in header.iter().zip(&f) {
             if !matches!(*name, "row" | "bounces" | "psnr_db") {
                 assert!(v.parse::<f64>().is_ok(), "{name} = {v} in {line}");

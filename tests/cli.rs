@@ -109,11 +109,120 @@ fn bad_values_get_a_clear_message_and_status_2() {
             ],
             "limit",
         ),
+        (
+            &["render", "--size", "65535x65535"],
+            "--size 65535x65535 is 65535x131070 = ",
+        ),
+        (
+            &["render", "-o", "/nonexistent/box.jpg"],
+            "cannot write .jpg",
+        ),
+        (
+            &["--scene", "/nonexistent/box.toml", "render"],
+            "--scene /nonexistent/box.toml: no such file: give the path of an existing .toml",
+        ),
+        (&["--scene", "/", "render"], "--scene /: is a folder"),
+        (
+            &["--scene", "scenes/tetrahedron.obj", "render"],
+            "an OBJ mesh is not a scene: write a .toml scene with an [[object]] of kind = \"obj\" and path = \"tetrahedron.obj\"",
+        ),
+        (
+            &["--scene", "Cornell", "render"],
+            "name; did you mean `cornell`? (built-in scenes: cornell, ",
+        ),
     ] {
         let out = raytty(args);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn no_color_makes_the_default_text_format_ascii() {
+    let run = |no_color: bool, args: &[&str]| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_raytty"));
+        cmd.args(["render", "--size", "12x4"]).args(args);
+        if no_color {
+            cmd.env("NO_COLOR", "1");
+        } else {
+            cmd.env_remove("NO_COLOR");
+        }
+        let out = cmd.output().unwrap();
+        assert!(out.status.success());
+        String::from_utf8(out.stdout).unwrap()
+    };
+    assert!(run(false, &[]).contains("\x1b[38;2;"));
+    let plain = run(true, &[]);
+    assert!(
+        !plain.contains('\x1b') && plain.lines().count() == 4,
+        "{plain:?}"
+    );
+    // An explicit --format still wins.
+    assert!(run(true, &["--format", "ansi"]).contains("\x1b[38;2;"));
+}
+
+/// The PFM `raytty render --stage gi --samples n` writes, as linear floats.
+fn gi_pixels(samples: &str) -> Vec<f32> {
+    let out = raytty(&[
+        "render",
+        "--stage",
+        "gi",
+        "--pixels",
+        "24x24",
+        "--format",
+        "pfm",
+        "--samples",
+        samples,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let header = "PF\n24 24\n-1.0\n".len();
+    out.stdout[header..]
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect()
+}
+
+#[test]
+fn samples_make_the_gi_stage_converge() {
+    let reference = gi_pixels("256");
+    let error = |samples: &str| -> f32 {
+        let p = gi_pixels(samples);
+        p.iter()
+            .zip(&reference)
+            .map(|(a, b)| (a - b).abs())
+            .sum::<f32>()
+            / p.len() as f32
+    };
+    let (one, sixteen) = (error("1"), error("16"));
+    assert!(
+        sixteen < one / 2.0,
+        "16 samples ({sixteen}) are not much closer to 256 than 1 sample ({one})"
+    );
+    let out = raytty(&["render", "--samples", "0"]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn output_failures_are_one_line_with_status_1() {
+    for (args, needle) in [
+        (
+            &["render", "-o", "/nonexistent/box.png"][..],
+            "raytty: cannot create /nonexistent/box.png: No such file or directory\n",
+        ),
+        (
+            &["render", "-o", "/dev/full"],
+            "raytty: cannot write to /dev/full: No space left on device\n",
+        ),
+    ] {
+        let out = raytty(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(err, needle, "{args:?}");
     }
 }

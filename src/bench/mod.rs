@@ -39,13 +39,20 @@ pub const AA_SPP: [u32; 2] = [4, 16];
 /// GI rows: these bounce counts, each at a ladder of samples per pixel.
 pub const GI_BOUNCES: [u32; 4] = [1, 2, 4, 8];
 
+/// The most runs a fast row gets.
+pub const MAX_RUNS: u32 = 51;
+
 /// What to measure.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BenchOptions {
     /// Image sizes in pixels, width × height.
     pub sizes: Vec<(u32, u32)>,
-    /// Timed runs per row, after one warm-up run.
+    /// Timed runs per row, after one warm-up run (at least; see `min_row_time`).
     pub runs: u32,
+    /// A fast row is run more than `runs` times, until its timed runs add up to this long (or
+    /// [`MAX_RUNS`]): a frame of a few milliseconds is at the mercy of the scheduler, and the
+    /// median of more runs steadies it at little cost.
+    pub min_row_time: Duration,
     /// The GI ladder goes 1, 4, 16, … up to this many samples per pixel.
     pub max_spp: u32,
     /// The reference's samples per pixel.
@@ -65,6 +72,7 @@ impl BenchOptions {
         BenchOptions {
             sizes: vec![(500, 500), (200, 100)],
             runs: 5,
+            min_row_time: Duration::from_millis(500),
             max_spp: 64,
             ref_spp: 1024,
             ref_bounces: 16,
@@ -73,12 +81,14 @@ impl BenchOptions {
         }
     }
 
-    /// A bench that runs in a second or two (for tests): tiny sizes, 2 runs, GI up to 4 spp,
+    /// A bench that runs in a second or two (for tests): tiny sizes, 2 runs (no more for fast
+    /// rows), GI up to 4 spp,
     /// a 64 spp, 8-bounce reference.
     pub fn quick() -> BenchOptions {
         BenchOptions {
             sizes: vec![(40, 40), (32, 16)],
             runs: 2,
+            min_row_time: Duration::ZERO,
             max_spp: 4,
             ref_spp: 64,
             ref_bounces: 8,
@@ -182,6 +192,8 @@ pub struct Row {
     pub min_ms: f64,
     /// Slowest run, in milliseconds.
     pub max_ms: f64,
+    /// Timed runs (the median is over these).
+    pub runs: u32,
     /// Rays traced per frame, by kind.
     pub rays: RayCounts,
     /// Millions of rays per second at the median time.
@@ -259,7 +271,7 @@ pub fn run(scene: &Scene, options: &BenchOptions) -> io::Result<BenchReport> {
                 kind.label().split(' ').next().unwrap_or(""),
                 kind.spp()
             ));
-            rows.push(measure(scene, *kind, w, h, runs, reference, || {
+            rows.push(measure(scene, *kind, w, h, options, reference, || {
                 bar.inc(kind.weight())
             }));
         }
@@ -278,16 +290,17 @@ pub fn run(scene: &Scene, options: &BenchOptions) -> io::Result<BenchReport> {
     })
 }
 
-/// Renders one row `runs + 1` times (the first is a warm-up) and measures it.
+/// Renders one row `runs + 1` times or more (the first is a warm-up) and measures it.
 fn measure(
     scene: &Scene,
     kind: RowKind,
     width: u32,
     height: u32,
-    runs: u32,
+    options: &BenchOptions,
     reference: &Image,
     mut tick: impl FnMut(),
 ) -> Row {
+    let (runs, min_row_time) = (options.runs.max(1), options.min_row_time);
     let settings = kind.settings(scene);
     let once = || {
         let start = Instant::now();
@@ -304,11 +317,17 @@ fn measure(
     let (frame, _) = once();
     tick();
     let mut times: Vec<Duration> = Vec::with_capacity(runs as usize);
-    for _ in 0..runs {
+    let mut total = Duration::ZERO;
+    while times.len() < runs as usize
+        || (total < min_row_time && times.len() < MAX_RUNS.max(runs) as usize)
+    {
         let (f, t) = once();
         debug_assert_eq!(f.image, frame.image, "frames are deterministic");
         times.push(t);
-        tick();
+        total += t;
+        if times.len() <= runs as usize {
+            tick();
+        }
     }
     times.sort();
     let ms = |d: Duration| d.as_secs_f64() * 1e3;
@@ -324,6 +343,7 @@ fn measure(
         height,
         kind,
         median_ms,
+        runs: times.len() as u32,
         min_ms: ms(times[0]),
         max_ms: ms(times[times.len() - 1]),
         rays,

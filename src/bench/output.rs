@@ -10,14 +10,14 @@ pub const README_START: &str = "<!-- bench:start -->";
 /// See [`README_START`].
 pub const README_END: &str = "<!-- bench:end -->";
 
-/// The columns of the table and of the CSV, in order.
-pub const COLUMNS: [&str; 16] = [
+/// The columns of the Markdown table, in order.
+pub const COLUMNS: [&str; 14] = [
     "size",
     "row",
     "spp",
     "bounces",
     "median ms",
-    "min–max ms",
+    "min–max ms (runs)",
     "primary",
     "shadow",
     "bounce",
@@ -26,8 +26,6 @@ pub const COLUMNS: [&str; 16] = [
     "RMSE",
     "PSNR dB",
     "ANSI bytes",
-    "width",
-    "height",
 ];
 
 /// The Markdown table, preceded by where and when it was measured (`command` is what produced
@@ -43,8 +41,7 @@ pub fn markdown(report: &BenchReport, command: &str) -> String {
         "Measured {} on {}, {} threads{load}, with `{command}`.\n",
         env.date, env.machine, env.threads
     );
-    // The table drops the CSV's separate width and height columns: `size` says both.
-    let cols = &COLUMNS[..14];
+    let cols = &COLUMNS;
     let _ = writeln!(s, "| {} |", cols.join(" | "));
     let align: Vec<&str> = cols
         .iter()
@@ -109,7 +106,7 @@ pub fn markdown(report: &BenchReport, command: &str) -> String {
     s
 }
 
-/// The table's cells of one row (the first 14 columns).
+/// The table's cells of one row.
 fn cells(r: &Row) -> Vec<String> {
     vec![
         format!("{}x{}", r.width, r.height),
@@ -117,7 +114,7 @@ fn cells(r: &Row) -> Vec<String> {
         r.kind.spp().to_string(),
         r.kind.bounces().map_or(String::new(), |b| b.to_string()),
         format!("{:.1}", r.median_ms),
-        format!("{:.1}–{:.1}", r.min_ms, r.max_ms),
+        format!("{:.1}–{:.1} ({})", r.min_ms, r.max_ms, r.runs),
         r.rays.primary.to_string(),
         r.rays.shadow.to_string(),
         r.rays.bounce.to_string(),
@@ -141,18 +138,19 @@ fn psnr(p: f64) -> String {
 /// times split into median, min and max. No field needs quoting.
 pub fn csv(report: &BenchReport) -> String {
     let mut s = String::from(
-        "width,height,row,spp,bounces,median_ms,min_ms,max_ms,primary,shadow,bounce,reflection,\
+        "width,height,row,spp,bounces,runs,median_ms,min_ms,max_ms,primary,shadow,bounce,reflection,\
          mrays_per_s,rmse,psnr_db,ansi_bytes\n",
     );
     for r in &report.rows {
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{},{},{:.3},{:.6},{},{}",
+            "{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{},{},{:.3},{:.6},{},{}",
             r.width,
             r.height,
             r.kind.label().replace(',', ";"),
             r.kind.spp(),
             r.kind.bounces().map_or(String::new(), |b| b.to_string()),
+            r.runs,
             r.median_ms,
             r.min_ms,
             r.max_ms,

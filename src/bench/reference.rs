@@ -97,6 +97,8 @@ pub struct ReferenceInfo {
     pub cached: bool,
     /// Time spent rendering it now (zero when cached).
     pub render_time: Duration,
+    /// Samples per pixel taken over from a partial or smaller cached reference (0 if none).
+    pub resumed_spp: u32,
 }
 
 impl ReferenceInfo {
@@ -105,6 +107,12 @@ impl ReferenceInfo {
         let s = &self.spec;
         let how = if self.cached {
             "read from the cache".to_string()
+        } else if self.resumed_spp > 0 {
+            format!(
+                "rendered in {:.1} s after the first {} spp (cached before)",
+                self.render_time.as_secs_f64(),
+                self.resumed_spp
+            )
         } else {
             format!("rendered in {:.1} s", self.render_time.as_secs_f64())
         };
@@ -117,8 +125,19 @@ impl ReferenceInfo {
             s.passes(),
             s.bounces,
             s.scene,
-            self.path.display()
+            home_relative(&self.path)
         )
+    }
+}
+
+/// `path` with the home directory written as `~`, as a person would type it.
+fn home_relative(path: &Path) -> String {
+    match std::env::var_os("HOME").filter(|h| !h.is_empty()) {
+        Some(home) => match path.strip_prefix(&home) {
+            Ok(rest) => format!("~/{}", rest.display()),
+            Err(_) => path.display().to_string(),
+        },
+        None => path.display().to_string(),
     }
 }
 
@@ -149,17 +168,18 @@ pub fn load_or_render(
     progress: bool,
 ) -> io::Result<(Image, ReferenceInfo)> {
     let path = dir.join(spec.file_name());
-    let info = |cached, render_time| ReferenceInfo {
+    let info = |cached, render_time, resumed_spp| ReferenceInfo {
         spec: spec.clone(),
         path: path.clone(),
         cached,
         render_time,
+        resumed_spp,
     };
     if let Ok(bytes) = fs::read(&path)
         && let Some(img) = read_pfm(&bytes)
         && (img.width, img.height) == (spec.width, spec.height)
     {
-        return Ok((img, info(true, Duration::ZERO)));
+        return Ok((img, info(true, Duration::ZERO, 0)));
     }
     fs::create_dir_all(dir)?;
     let partial = path.with_extension("partial.pfm");
@@ -202,6 +222,7 @@ pub fn load_or_render(
         &format!("reference {}x{}", spec.width, spec.height),
         progress,
     );
+    let resumed = done;
     bar.set_position(u64::from(done));
     let start = Instant::now();
     let mut mean = Image::new(spec.width, spec.height);
@@ -231,7 +252,7 @@ pub fn load_or_render(
     write_atomically(&path, &pfm_bytes(&mean)?)?;
     let _ = fs::remove_file(&partial);
     let _ = fs::remove_file(&partial_count);
-    Ok((mean, info(false, start.elapsed())))
+    Ok((mean, info(false, start.elapsed(), resumed * PASS_SPP)))
 }
 
 /// A bar on stderr, hidden unless `show` and stderr is a terminal.
