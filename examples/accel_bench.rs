@@ -37,6 +37,16 @@ fn trace_rate(scene: &Scene, w: u32, h: u32) -> f64 {
     rays.len() as f64 / best.as_secs_f64() / 1e6
 }
 
+/// CPU time of this process so far (all threads, user + system), from /proc (Linux): on a
+/// loaded machine it says what the work costs where wall-clock time does not.
+fn cpu_time() -> Option<Duration> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let fields: Vec<&str> = stat.rsplit(')').next()?.split_whitespace().collect();
+    let ticks: u64 = fields.get(11)?.parse::<u64>().ok()? + fields.get(12)?.parse::<u64>().ok()?;
+    // The kernel's USER_HZ is 100 on every Linux target we run on.
+    Some(Duration::from_millis(ticks * 10))
+}
+
 /// Peak resident memory of this process, from /proc (Linux), in MiB.
 fn peak_rss_mib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -47,7 +57,7 @@ fn peak_rss_mib() -> Option<f64> {
 
 /// The built-in `sphere` scene's layout: the Cornell room's five walls and a displaced
 /// icosphere of radius 0.6 resting above the floor.
-fn sphere_scene(k: u32) -> (Scene, Duration, Duration) {
+fn sphere_scene(k: u32) -> (Scene, Duration, Duration, Option<Duration>) {
     let start = Instant::now();
     let mesh = displaced_icosphere(k, 0.08);
     let generate = start.elapsed();
@@ -88,11 +98,13 @@ fn sphere_scene(k: u32) -> (Scene, Duration, Duration) {
     let offset = Vec3::new(0.0, 0.3, 0.1);
     b.object(mesh.into_iter().map(|t| t.map(|p| p * 0.6 + offset)), gold);
     b.light(raytty::cornell::LIGHT);
-    let start = Instant::now();
+    let (start, cpu) = (Instant::now(), cpu_time());
     let scene = b
         .build("sphere", Camera::default(), Effects::SEED)
         .expect("the sphere scene is valid");
-    (scene, generate, start.elapsed())
+    let wall = start.elapsed();
+    let cpu = cpu.zip(cpu_time()).map(|(a, b)| b - a);
+    (scene, generate, wall, cpu)
 }
 
 fn main() {
@@ -119,7 +131,7 @@ fn main() {
     );
 
     println!("## Displaced icosphere in the Cornell room (k = {k})\n");
-    let (scene, generate, build) = sphere_scene(k);
+    let (scene, generate, build, build_cpu) = sphere_scene(k);
     let stats = scene.accel_stats();
     println!(
         "{} triangles: mesh generated in {:.1} ms; SceneBuilder::build (validation + {}) {:.1} ms, of which the BVH {:.1} ms ({} nodes, depth {})",
@@ -131,6 +143,12 @@ fn main() {
         stats.nodes,
         stats.depth
     );
+    if let Some(cpu) = build_cpu {
+        println!(
+            "SceneBuilder::build CPU time, all threads: {:.0} ms",
+            cpu.as_secs_f64() * 1e3
+        );
+    }
     if let Some(mib) = peak_rss_mib() {
         println!("peak RSS after building: {mib:.0} MiB\n");
     }
