@@ -23,6 +23,7 @@
 mod build;
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use crate::accel::Hit;
 use crate::geometry::{Ray, Triangle, gamma, intersect_watertight, next_float_up};
@@ -238,11 +239,11 @@ impl Bvh {
         let built = build::build(triangles);
         let vertices = built
             .order
-            .iter()
+            .par_iter()
             .map(|&i| triangles[i as usize].v)
             .collect();
         Bvh {
-            nodes: built.pairs.into_iter().map(Pair::new).collect(),
+            nodes: built.pairs.into_par_iter().map(Pair::new).collect(),
             vertices,
             ids: built.order,
             depth: built.depth,
