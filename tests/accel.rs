@@ -346,3 +346,11 @@ fn leaves_hold_a_few_triangles() {
     // A well-balanced tree over 18000 triangles is a few dozen levels at most.
     assert!(bvh.depth() < 40, "depth {}", bvh.depth());
 }
+
+/// The 1M-triangle sphere (k = 224) against brute force: slow (each brute-force ray tests a
+/// million triangles; 17 s here), so run by hand: `cargo test --test accel -- --ignored`.
+#[test]
+#[ignore]
+fn million_triangle_icosphere_matches_brute_force() {
+    assert_exact(displaced_icosphere(224, 0.08), 41, 300, 2.0);
+}
