@@ -293,7 +293,8 @@ fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
     )
     .map_err(|e| match e {
         raytty::bench::BenchError::Usage(m) => UsageError(m).into(),
-        e => anyhow::Error::new(e),
+        // The I/O error as the cause, said once (BenchError's own text repeats it).
+        raytty::bench::BenchError::Io { what, error } => anyhow::Error::new(error).context(what),
     })
 }
 

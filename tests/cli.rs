@@ -226,3 +226,20 @@ fn output_failures_are_one_line_with_status_1() {
         assert_eq!(err, needle, "{args:?}");
     }
 }
+
+#[test]
+fn a_bench_file_error_says_its_cause_once() {
+    let cache = std::env::temp_dir().join(format!("raytty-cli-cache-{}", std::process::id()));
+    let out = Command::new(env!("CARGO_BIN_EXE_raytty"))
+        .args(["bench", "--quick", "--readme", "/nonexistent/README.md"])
+        .env("XDG_CACHE_HOME", &cache)
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&cache);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.ends_with("raytty: cannot read /nonexistent/README.md: No such file or directory\n"),
+        "{err}"
+    );
+}
