@@ -3,8 +3,9 @@
 //! [`SceneFileError`] naming the file, line and column, what was wrong and what would be right.
 //! `scenes/example.toml` documents every key.
 //!
-//! A file that loads is a valid [`Scene`]: it goes through [`SceneBuilder`], and everything the
-//! builder would reject (degenerate triangles, bad lights) is caught first, here, with a line.
+//! A file that loads is a valid [`Scene`]: it goes through [`crate::SceneBuilder`], and everything
+//! the builder would reject (degenerate triangles, bad lights) is caught first, here, with a
+//! line.
 
 mod build;
 mod check;

@@ -160,3 +160,32 @@ fn the_command_line_lists_scenes_and_takes_a_name_or_a_file() {
         "the mirror scene looks like the Cornell box"
     );
 }
+
+#[test]
+fn a_camera_in_a_file_is_the_same_camera_as_on_the_command_line() {
+    let dir = std::env::temp_dir().join(format!("raytty-scenes-camera-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("turned.toml");
+    let source = builtin::find("cornell").unwrap().source.replace(
+        "position = [0, 0, -3]\nyaw = 0",
+        "position = [0.3, -0.1, -2.5]\nyaw = 15",
+    );
+    std::fs::write(&file, source).unwrap();
+    let raytty = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_raytty"))
+            .args(["render", "--format", "pfm", "--pixels", "40x30"])
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out.stdout
+    };
+    let from_file = raytty(&["--scene", file.to_str().unwrap()]);
+    let from_flag = raytty(&["--camera", "0.3,-0.1,-2.5,15"]);
+    assert_eq!(from_file, from_flag, "the two cameras differ");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

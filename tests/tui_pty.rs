@@ -348,6 +348,20 @@ fn the_app_shows_the_scene_given_with_scene() {
 }
 
 #[test]
+fn a_bad_scene_is_refused_before_the_terminal_is_touched() {
+    let mut s = Session::start_with(100, 10, false, &["--scene", "no-such-scene"]);
+    let status = s.finish();
+    assert_eq!(status.exit_code(), 2);
+    let screen = s.screen.screen();
+    assert!(!screen.alternate_screen() && !screen.hide_cursor());
+    let text = screen.contents();
+    assert!(
+        text.contains("no-such-scene") && text.contains("cornell, mirror, lights, sphere"),
+        "{text}"
+    );
+}
+
+#[test]
 fn the_loading_note_is_erased_when_the_app_ends_and_before_an_error() {
     let mut s = Session::start(60, 10, false);
     s.wait_for_status(&["indirect"]);

@@ -9,7 +9,6 @@ use super::check::Ctx;
 use super::error::{SceneFileError, did_you_mean};
 use super::spec::{NumberOrTriple, ObjectSpec};
 use super::*;
-use crate::frame::printable;
 use crate::geometry::Triangle;
 use crate::obj::parse_obj;
 use crate::procedural::{displaced_icosphere, icosphere_triangles};
@@ -61,28 +60,45 @@ pub fn object_triangles(
         "obj" => mesh(cx, object, budget, read_mesh)?,
         _ => (icosphere(cx, object, budget, over)?, Origins::Object(at)),
     };
-    transform(cx, o, &mut tris)?;
-    // In parallel (a procedural mesh has a million triangles); the first bad one is reported.
-    let bad = tris
-        .par_iter()
-        .position_first(|&t| triangle_problem(t).is_some());
-    let Some(i) = bad else {
-        return Ok(tris);
+    // A triangle degenerate as given is the object's own fault; one that the transform makes
+    // degenerate (a tiny object far from the origin, where f32 steps are coarse) is the
+    // transform's.
+    let report = |i: usize, problem: String, after: bool| {
+        let why = if after {
+            "after the transform of the object at"
+        } else {
+            "in the object at"
+        };
+        match &origins {
+            Origins::Each(offsets) => cx.err(offsets[i], problem),
+            Origins::Object(offset) => cx.err(*offset, problem),
+            Origins::Mesh(file, faces) => SceneFileError::at_line(
+                file,
+                "",
+                faces[i].0 as usize,
+                faces[i].1 as usize,
+                format!("{problem} ({why} {})", cx.place(at)),
+            ),
+        }
     };
-    let problem = triangle_problem(tris[i]).unwrap_or_default();
-    Err(match origins {
-        Origins::Each(offsets) => cx.err(offsets[i], problem),
-        Origins::Object(offset) => cx.err(offset, problem),
-        Origins::Mesh(file, faces) => SceneFileError {
-            file: printable(&file),
-            line: faces[i].0 as usize,
-            column: faces[i].1 as usize,
-            message: printable(&format!(
-                "{problem} (after the transform of the object at {})",
-                cx.place(at)
-            )),
-        },
-    })
+    if let Some((i, problem)) = first_bad(&tris, false) {
+        return Err(report(i, problem, false));
+    }
+    if o.scale.is_some() || o.rotate_y.is_some() || o.translate.is_some() {
+        transform(cx, o, &mut tris)?;
+        if let Some((i, problem)) = first_bad(&tris, true) {
+            return Err(report(i, problem, true));
+        }
+    }
+    Ok(tris)
+}
+
+/// The first triangle with a problem, in parallel (a procedural mesh has a million).
+fn first_bad(tris: &[[Vec3; 3]], transformed: bool) -> Option<(usize, String)> {
+    let i = tris
+        .par_iter()
+        .position_first(|&t| triangle_problem(t, transformed).is_some())?;
+    Some((i, triangle_problem(tris[i], transformed)?))
 }
 
 /// The kind is known, and every key given belongs to it.
@@ -209,15 +225,18 @@ fn mesh(
             format!("{e}; give the path of an OBJ file, relative to the scene file's folder"),
         )
     })?;
-    let mesh = parse_obj(&bytes, budget, MAX_MESH_VERTICES).map_err(|e| SceneFileError {
-        file: printable(&shown),
-        line: e.line,
-        column: e.column,
-        message: printable(&format!(
-            "{} (in the mesh named at {})",
-            e.message,
-            cx.place(path.span().start)
-        )),
+    let mesh = parse_obj(&bytes, budget, MAX_MESH_VERTICES).map_err(|e| {
+        SceneFileError::at_line(
+            &shown,
+            &String::from_utf8_lossy(&bytes),
+            e.line,
+            e.column,
+            format!(
+                "{} (in the mesh named at {})",
+                e.message,
+                cx.place(path.span().start)
+            ),
+        )
     })?;
     if mesh.triangles.is_empty() {
         return Err(cx.err_at(
@@ -256,18 +275,27 @@ fn icosphere(
     Ok(displaced_icosphere(k, amplitude as f32))
 }
 
-/// What is wrong with a transformed triangle, if anything: a vertex beyond the coordinate
-/// limit, or a degenerate shape the scene would reject.
-fn triangle_problem([a, b, c]: [Vec3; 3]) -> Option<String> {
+/// What is wrong with a triangle, if anything: a vertex beyond the coordinate limit, or a
+/// degenerate shape the scene would reject. `transformed`: the object's transform was applied.
+fn triangle_problem([a, b, c]: [Vec3; 3], transformed: bool) -> Option<String> {
     if [a, b, c]
         .iter()
         .any(|v| !(v.abs().max_element() <= MAX_COORDINATE as f32))
     {
-        return Some(format!(
-            "a vertex is beyond ±{MAX_COORDINATE:e} after the object's transform: make the scale or translate smaller"
-        ));
+        return Some(if transformed {
+            format!(
+                "a vertex is beyond ±{MAX_COORDINATE:e} after the object's transform: make the scale or translate smaller"
+            )
+        } else {
+            format!("a vertex of the object is beyond ±{MAX_COORDINATE:e}")
+        });
     }
-    Triangle::new(a, b, c, 0).err().map(|e| {
+    let e = Triangle::new(a, b, c, 0).err()?;
+    Some(if transformed {
+        format!(
+            "the transform makes a triangle degenerate ({e}): it is too small for its distance from the origin in single precision; scale it up or move it nearer the origin"
+        )
+    } else {
         format!(
             "degenerate triangle: {e}; every triangle needs three distinct vertices that are not on one line"
         )
