@@ -250,13 +250,31 @@ pub fn main() -> ExitCode {
 /// `--scene`, what that scene costs (load and acceleration build, frame times, M rays/s).
 fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
     if let Some(name) = scene {
+        // These shape the accuracy bench only: refuse them rather than ignore them.
+        let unused: Vec<&str> = [
+            (a.csv, "--csv"),
+            (a.svg.is_some(), "--svg"),
+            (a.readme.is_some(), "--readme"),
+            (a.max_spp.is_some(), "--max-spp"),
+            (a.ref_spp.is_some(), "--ref-spp"),
+            (a.ref_bounces.is_some(), "--ref-bounces"),
+        ]
+        .into_iter()
+        .filter_map(|(given, flag)| given.then_some(flag))
+        .collect();
+        if !unused.is_empty() {
+            bail!(UsageError(format!(
+                "{} belong to the accuracy bench (no --scene); with --scene, bench times frames: --sizes, --runs, --quick",
+                unused.join(", ")
+            )));
+        }
         let start = std::time::Instant::now();
         let scene = crate::scene_arg::load_scene(Some(name))?;
         let load = start.elapsed();
-        let sizes = if a.sizes.is_empty() {
-            vec![(200, 100), (500, 500)]
-        } else {
-            a.sizes
+        let sizes = match (a.sizes.is_empty(), a.quick) {
+            (false, _) => a.sizes,
+            (true, true) => raytty::bench::BenchOptions::quick().sizes,
+            (true, false) => vec![(200, 100), (500, 500)],
         };
         let runs = a.runs.unwrap_or(if a.quick { 2 } else { 5 });
         let report = raytty::scene_bench::bench_scene(&scene, &sizes, runs);
@@ -269,6 +287,17 @@ fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
         )?;
         out.write_all(report.to_markdown().as_bytes())?;
         return Ok(());
+    }
+    // The plot is written after the (long) run: a folder that does not exist fails now.
+    if let Some(dir) = a.svg.as_deref().and_then(std::path::Path::parent)
+        && !dir.as_os_str().is_empty()
+        && !dir.is_dir()
+    {
+        bail!(UsageError(format!(
+            "--svg {}: the folder {} does not exist",
+            a.svg.as_deref().unwrap_or(dir).display(),
+            dir.display()
+        )));
     }
     let request = raytty::bench::BenchRequest {
         quick: a.quick,

@@ -243,3 +243,43 @@ fn a_bench_file_error_says_its_cause_once() {
         "{err}"
     );
 }
+
+#[test]
+fn bench_flags_that_would_be_ignored_or_fail_late_are_refused_first() {
+    for (args, needle) in [
+        (
+            &["bench", "--scene", "cornell", "--csv"][..],
+            "--csv belong to the accuracy bench",
+        ),
+        (
+            &[
+                "bench",
+                "--scene",
+                "cornell",
+                "--svg",
+                "p.svg",
+                "--max-spp",
+                "4",
+            ],
+            "--svg, --max-spp belong",
+        ),
+        (
+            &["bench", "--quick", "--svg", "/nonexistent/plot.svg"],
+            "--svg /nonexistent/plot.svg: the folder /nonexistent does not exist",
+        ),
+    ] {
+        let out = raytty(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(out.stdout.is_empty(), "{args:?} ran before refusing");
+    }
+    // --quick with --scene: the quick bench's tiny sizes, not 500×500.
+    let out = raytty(&["bench", "--scene", "cornell", "--quick"]);
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(
+        table.contains("| 40×40 |") && !table.contains("500×500"),
+        "{table}"
+    );
+}
