@@ -443,6 +443,11 @@ fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
         camera.position = Vec3::new(x, y, z);
         camera.yaw = yaw.to_radians();
     }
+    if args.light.is_some() && scene.lights.is_empty() {
+        bail!(UsageError(
+            "--light moves the scene's first light, and this scene has none: add a [[light]] to the scene file".into()
+        ));
+    }
     let lights = lights_with(&scene, args.light);
     let mut settings = args.stage.settings(scene.effects);
     if let Some(n) = args.samples {

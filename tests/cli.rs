@@ -283,3 +283,23 @@ fn bench_flags_that_would_be_ignored_or_fail_late_are_refused_first() {
         "{table}"
     );
 }
+
+#[test]
+fn light_on_a_scene_without_lights_is_refused() {
+    let dir = std::env::temp_dir().join(format!("raytty-cli-nolight-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("dark.toml");
+    std::fs::write(
+        &file,
+        "[material.w]\ncolour = [0.5, 0.5, 0.5]\n[[object]]\nkind = \"box\"\nmaterial = \"w\"\nmin = [-1, -1, -1]\nmax = [1, 1, 1]\n",
+    )
+    .unwrap();
+    let scene = file.to_str().unwrap();
+    let lit = raytty(&["--scene", scene, "render", "--light", "0,0,0"]);
+    let plain = raytty(&["--scene", scene, "render", "--format", "ascii"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+    let err = String::from_utf8_lossy(&lit.stderr);
+    assert_eq!(lit.status.code(), Some(2), "{err}");
+    assert!(err.contains("this scene has none"), "{err}");
+    assert!(plain.status.success());
+}
