@@ -15,7 +15,7 @@ use raytty::{CellGrid, ColorMode, PointLight, Scene, Stage, encode_text, render}
 /// Renders the Cornell box (or another scene) by ray tracing, in the terminal.
 ///
 /// With no command on a terminal, raytty runs the interactive app; when stdout is not a
-/// terminal it prints one frame, as `raytty render` would. Frames are truecolor half-blocks:
+/// terminal (or TERM is dumb) it prints one frame, as `raytty render` would. Frames are truecolor half-blocks:
 /// each cell shows two pixels, so an 80×24 frame is 80×48 pixels.
 #[derive(Parser, Debug)]
 #[command(name = "raytty", version, about, long_about)]
