@@ -54,8 +54,9 @@ pub fn icosahedron_vertices() -> [DVec3; 12] {
 
 /// A smooth, deterministic bump field on the unit sphere, in [-1, 1].
 fn bumps(d: DVec3) -> f64 {
-    let a = (5.0 * d.x + 1.3).sin() * (4.0 * d.y - 0.7).sin() * (6.0 * d.z + 0.4).sin();
-    let b = (13.0 * d.x - 2.0 * d.z).sin() * (11.0 * d.y + 3.0 * d.x).sin();
+    use libm::sin;
+    let a = sin(5.0 * d.x + 1.3) * sin(4.0 * d.y - 0.7) * sin(6.0 * d.z + 0.4);
+    let b = sin(13.0 * d.x - 2.0 * d.z) * sin(11.0 * d.y + 3.0 * d.x);
     (0.7 * a + 0.3 * b).clamp(-1.0, 1.0)
 }
 

@@ -319,7 +319,7 @@ fn transform(cx: &Ctx, o: &ObjectSpec, tris: &mut [[Vec3; 3]]) -> Result<(), Sce
             .ranged(r, -360.0, 360.0, "rotate_y (degrees)")?
             .to_radians();
         // The camera's convention: a positive angle turns +z towards +x.
-        let (s, c) = (angle.sin() as f32, angle.cos() as f32);
+        let (s, c) = (libm::sin(angle) as f32, libm::cos(angle) as f32);
         tris.iter_mut()
             .flatten()
             .for_each(|v| *v = Vec3::new(c * v.x + s * v.z, v.y, c * v.z - s * v.x));
