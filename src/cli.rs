@@ -122,9 +122,10 @@ enum Format {
 /// Options of `raytty render`.
 #[derive(Args, Debug)]
 struct RenderArgs {
-    /// Frame size in terminal cells, COLSxROWS (text formats: COLS × 2·ROWS pixels).
-    #[arg(long, value_name = "COLSxROWS", value_parser = parse_size, default_value = "80x24")]
-    size: (u32, u32),
+    /// Frame size in terminal cells, COLSxROWS: COLS × 2·ROWS pixels (default 80x24 for text;
+    /// images default to 500x500 pixels unless --size or --pixels is given).
+    #[arg(long, value_name = "COLSxROWS", value_parser = parse_size)]
+    size: Option<(u32, u32)>,
     /// Image size in pixels, WxH (default 500x500 for png and pfm; overrides --size).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pixels: Option<(u32, u32)>,
@@ -379,7 +380,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
     let _ = dumb;
     run_render(
         &RenderArgs {
-            size: (80, 24),
+            size: Some((80, 24)),
             pixels: None,
             format: Some(match color {
                 ColorMode::TrueColor => Format::Ansi,
@@ -421,16 +422,17 @@ fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
             format_name(format)
         )));
     }
-    let (w, h) = match (args.pixels, image_format) {
-        (Some(p), _) => p,
-        (None, true) => (500, 500),
-        (None, false) => (args.size.0, args.size.1 * 2),
+    let (w, h) = match (args.pixels, args.size, image_format) {
+        (Some(p), _, _) => p,
+        (None, Some((cols, rows)), _) => (cols, rows * 2),
+        (None, None, true) => (500, 500),
+        (None, None, false) => (80, 48),
     };
     let pixels = w as u64 * h as u64;
     if pixels > MAX_PIXELS {
         let asked = match args.pixels {
             Some(_) => format!("--pixels {w}x{h} is"),
-            None => format!("--size {}x{} is {w}x{h} =", args.size.0, args.size.1),
+            None => format!("--size {}x{} is {w}x{h} =", w, h / 2),
         };
         bail!(UsageError(format!(
             "{asked} {pixels} pixels, about {} MiB of memory; the limit is {MAX_PIXELS} pixels (e.g. --pixels 8192x8192 or --size 8192x4096)",

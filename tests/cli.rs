@@ -57,6 +57,11 @@ fn images_are_written_to_files() {
     let bytes = std::fs::read(&pfm).unwrap();
     assert!(bytes.starts_with(b"PF\n64 32\n-1.0\n"));
     assert_eq!(bytes.len(), "PF\n64 32\n-1.0\n".len() + 64 * 32 * 12);
+    // --size gives an image the pixels of that many cells; the extension picks the format.
+    let sized = dir.join("cells.pfm");
+    let out = raytty(&["render", "--size", "20x6", "-o", sized.to_str().unwrap()]);
+    assert!(out.status.success());
+    assert!(std::fs::read(&sized).unwrap().starts_with(b"PF\n20 12\n"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
