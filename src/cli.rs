@@ -15,7 +15,7 @@ use raytty::{CellGrid, ColorMode, PointLight, Scene, Stage, encode_text, render}
 /// Renders the Cornell box (or another scene) by ray tracing, in the terminal.
 ///
 /// With no command on a terminal, raytty runs the interactive app; when stdout is not a
-/// terminal it prints one frame, as `raytty render` would. Frames are truecolor half-blocks:
+/// terminal (or TERM is dumb) it prints one frame, as `raytty render` would. Frames are truecolor half-blocks:
 /// each cell shows two pixels, so an 80×24 frame is 80×48 pixels.
 #[derive(Parser, Debug)]
 #[command(name = "raytty", version, about, long_about)]
@@ -122,9 +122,10 @@ enum Format {
 /// Options of `raytty render`.
 #[derive(Args, Debug)]
 struct RenderArgs {
-    /// Frame size in terminal cells, COLSxROWS (text formats: COLS × 2·ROWS pixels).
-    #[arg(long, value_name = "COLSxROWS", value_parser = parse_size, default_value = "80x24")]
-    size: (u32, u32),
+    /// Frame size in terminal cells, COLSxROWS: COLS × 2·ROWS pixels (default 80x24 for text;
+    /// images default to 500x500 pixels unless --size or --pixels is given).
+    #[arg(long, value_name = "COLSxROWS", value_parser = parse_size)]
+    size: Option<(u32, u32)>,
     /// Image size in pixels, WxH (default 500x500 for png and pfm; overrides --size).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pixels: Option<(u32, u32)>,
@@ -250,13 +251,31 @@ pub fn main() -> ExitCode {
 /// `--scene`, what that scene costs (load and acceleration build, frame times, M rays/s).
 fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
     if let Some(name) = scene {
+        // These shape the accuracy bench only: refuse them rather than ignore them.
+        let unused: Vec<&str> = [
+            (a.csv, "--csv"),
+            (a.svg.is_some(), "--svg"),
+            (a.readme.is_some(), "--readme"),
+            (a.max_spp.is_some(), "--max-spp"),
+            (a.ref_spp.is_some(), "--ref-spp"),
+            (a.ref_bounces.is_some(), "--ref-bounces"),
+        ]
+        .into_iter()
+        .filter_map(|(given, flag)| given.then_some(flag))
+        .collect();
+        if !unused.is_empty() {
+            bail!(UsageError(format!(
+                "{} belong to the accuracy bench (no --scene); with --scene, bench times frames: --sizes, --runs, --quick",
+                unused.join(", ")
+            )));
+        }
         let start = std::time::Instant::now();
         let scene = crate::scene_arg::load_scene(Some(name))?;
         let load = start.elapsed();
-        let sizes = if a.sizes.is_empty() {
-            vec![(200, 100), (500, 500)]
-        } else {
-            a.sizes
+        let sizes = match (a.sizes.is_empty(), a.quick) {
+            (false, _) => a.sizes,
+            (true, true) => raytty::bench::BenchOptions::quick().sizes,
+            (true, false) => vec![(200, 100), (500, 500)],
         };
         let runs = a.runs.unwrap_or(if a.quick { 2 } else { 5 });
         let report = raytty::scene_bench::bench_scene(&scene, &sizes, runs);
@@ -269,6 +288,17 @@ fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
         )?;
         out.write_all(report.to_markdown().as_bytes())?;
         return Ok(());
+    }
+    // The plot is written after the (long) run: a folder that does not exist fails now.
+    if let Some(dir) = a.svg.as_deref().and_then(std::path::Path::parent)
+        && !dir.as_os_str().is_empty()
+        && !dir.is_dir()
+    {
+        bail!(UsageError(format!(
+            "--svg {}: the folder {} does not exist",
+            a.svg.as_deref().unwrap_or(dir).display(),
+            dir.display()
+        )));
     }
     let request = raytty::bench::BenchRequest {
         quick: a.quick,
@@ -293,7 +323,8 @@ fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
     )
     .map_err(|e| match e {
         raytty::bench::BenchError::Usage(m) => UsageError(m).into(),
-        e => anyhow::Error::new(e),
+        // The I/O error as the cause, said once (BenchError's own text repeats it).
+        raytty::bench::BenchError::Io { what, error } => anyhow::Error::new(error).context(what),
     })
 }
 
@@ -349,7 +380,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
     let _ = dumb;
     run_render(
         &RenderArgs {
-            size: (80, 24),
+            size: Some((80, 24)),
             pixels: None,
             format: Some(match color {
                 ColorMode::TrueColor => Format::Ansi,
@@ -391,16 +422,17 @@ fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
             format_name(format)
         )));
     }
-    let (w, h) = match (args.pixels, image_format) {
-        (Some(p), _) => p,
-        (None, true) => (500, 500),
-        (None, false) => (args.size.0, args.size.1 * 2),
+    let (w, h) = match (args.pixels, args.size, image_format) {
+        (Some(p), _, _) => p,
+        (None, Some((cols, rows)), _) => (cols, rows * 2),
+        (None, None, true) => (500, 500),
+        (None, None, false) => (80, 48),
     };
     let pixels = w as u64 * h as u64;
     if pixels > MAX_PIXELS {
         let asked = match args.pixels {
             Some(_) => format!("--pixels {w}x{h} is"),
-            None => format!("--size {}x{} is {w}x{h} =", args.size.0, args.size.1),
+            None => format!("--size {}x{} is {w}x{h} =", w, h / 2),
         };
         bail!(UsageError(format!(
             "{asked} {pixels} pixels, about {} MiB of memory; the limit is {MAX_PIXELS} pixels (e.g. --pixels 8192x8192 or --size 8192x4096)",
@@ -412,6 +444,11 @@ fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
     if let Some([x, y, z, yaw]) = args.camera {
         camera.position = Vec3::new(x, y, z);
         camera.yaw = yaw.to_radians();
+    }
+    if args.light.is_some() && scene.lights.is_empty() {
+        bail!(UsageError(
+            "--light moves the scene's first light, and this scene has none: add a [[light]] to the scene file".into()
+        ));
     }
     let lights = lights_with(&scene, args.light);
     let mut settings = args.stage.settings(scene.effects);
