@@ -1,6 +1,7 @@
 //! A bounding volume hierarchy over a scene's triangles: binned SAH, built in parallel
-//! ([`build`]), stored as flat 32-byte nodes in depth-first order, traversed iteratively with a
-//! fixed stack.
+//! (`bvh/build.rs`), stored as 32-byte nodes in sibling pairs (one 64-byte cache line, boxes laid out
+//! slab by slab so both children are tested at once) in depth-first order, traversed
+//! iteratively with a fixed stack.
 //!
 //! The triangles' vertices are copied in leaf order, so a leaf's triangles sit next to each
 //! other in memory; each keeps its index in the scene, which is what a [`Hit`] reports.
@@ -22,13 +23,14 @@
 mod build;
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use crate::accel::Hit;
 use crate::geometry::{Ray, Triangle, gamma, intersect_watertight, next_float_up};
 
 pub use build::{LEAF_MAX, SAH_BINS};
 
-/// Most levels a hierarchy has (root = level 1); [`build`] keeps to it by switching from SAH to
+/// Most levels a hierarchy has (root = level 1); the builder keeps to it by switching from SAH to
 /// median splits deep down, so traversal can use a fixed stack.
 pub const MAX_DEPTH: usize = 64;
 
@@ -62,8 +64,8 @@ fn far_widen() -> f32 {
     1.0 + 2.0 * gamma(3)
 }
 
-/// One node: a box, and either two children (adjacent: a [`NodePair`]) or a run of triangles.
-/// 32 bytes.
+/// One node as the builder makes it: a box, and either two children (adjacent: a
+/// [`NodePair`]) or a run of triangles. 32 bytes; traversal reads them rearranged in [`Pair`]s.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub(crate) struct Node {
@@ -78,7 +80,7 @@ pub(crate) struct Node {
 
 const _: () = assert!(std::mem::size_of::<Node>() == 32);
 
-/// Two sibling nodes, aligned to share one 64-byte cache line: traversal tests both.
+/// Two sibling nodes, as built.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
 pub(crate) struct NodePair(pub(crate) [Node; 2]);
@@ -96,37 +98,129 @@ impl Node {
     fn is_leaf(&self) -> bool {
         self.count > 0
     }
+}
 
-    /// Robust slab test: where the ray enters the box, if it meets it for some `t` in
-    /// `[0, t_max]`. A NaN slab distance (the origin on a slab plane of a ray parallel to it)
-    /// constrains nothing, so such a box is kept.
+/// Two sibling nodes as traversal reads them, in one 64-byte cache line: the boxes laid out
+/// slab by slab, so that both children's slab distances along an axis come from one 4-wide
+/// operation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
+struct Pair {
+    /// Per axis: `[min of child 0, min of child 1, max of child 0, max of child 1]`.
+    slabs: [[f32; 4]; 3],
+    /// Each child's [`Node::offset`].
+    offset: [u32; 2],
+    /// Each child's [`Node::count`].
+    count: [u32; 2],
+}
+
+const _: () = assert!(std::mem::size_of::<Pair>() == 64);
+
+impl Pair {
+    fn new(NodePair(n): NodePair) -> Pair {
+        Pair {
+            slabs: [0, 1, 2].map(|a| [n[0].min[a], n[1].min[a], n[0].max[a], n[1].max[a]]),
+            offset: [n[0].offset, n[1].offset],
+            count: [n[0].count, n[1].count],
+        }
+    }
+
+    /// The node in lane `lane`.
+    fn node(&self, lane: usize) -> Node {
+        let s = &self.slabs;
+        Node {
+            min: Vec3::new(s[0][lane], s[1][lane], s[2][lane]),
+            offset: self.offset[lane],
+            max: Vec3::new(s[0][lane + 2], s[1][lane + 2], s[2][lane + 2]),
+            count: self.count[lane],
+        }
+    }
+
+    /// Robust slab test of both boxes: where the ray enters each, if it meets it for some `t`
+    /// in `[0, t_max]`. The far distance is widened by 1 + 2γ₃; a NaN slab distance (the
+    /// origin on a slab plane of a ray parallel to it) constrains nothing, so such a box is
+    /// kept. This is the portable form; x86-64 runs the same operations four lanes at a time.
+    #[cfg(not(target_arch = "x86_64"))]
     #[inline(always)]
-    fn enter(&self, origin: Vec3, inv_dir: Vec3, t_max: f32) -> Option<f32> {
+    fn enter(&self, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> [Option<f32>; 2] {
+        self.enter_portable(origin, inv_dir, t_max)
+    }
+
+    /// [`Pair::enter`] one box and one slab at a time.
+    #[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+    #[inline(always)]
+    fn enter_portable(
+        &self,
+        origin: &[f32; 3],
+        inv_dir: &[f32; 3],
+        t_max: f32,
+    ) -> [Option<f32>; 2] {
         let widen = far_widen();
-        let mut t0 = 0.0f32;
-        let mut t1 = t_max;
-        for i in 0..3 {
-            let a = (self.min[i] - origin[i]) * inv_dir[i];
-            let b = (self.max[i] - origin[i]) * inv_dir[i];
-            let (near, far) = if a > b { (b, a) } else { (a, b) };
-            let far = far * widen;
-            if near > t0 {
-                t0 = near;
-            }
-            if far < t1 {
-                t1 = far;
+        let mut t0 = [0.0f32; 2];
+        let mut t1 = [t_max; 2];
+        for axis in 0..3 {
+            let s = &self.slabs[axis];
+            let t: [f32; 4] = std::array::from_fn(|j| (s[j] - origin[axis]) * inv_dir[axis]);
+            for c in 0..2 {
+                let (a, b) = (t[c], t[c + 2]);
+                let (near, far) = if a > b { (b, a) } else { (a, b) };
+                let far = far * widen;
+                if near > t0[c] {
+                    t0[c] = near;
+                }
+                if far < t1[c] {
+                    t1[c] = far;
+                }
             }
         }
-        (t0 <= t1).then_some(t0)
+        [0, 1].map(|c| (t0[c] <= t1[c]).then_some(t0[c]))
+    }
+
+    /// The slab test above with SSE2 (part of every x86-64), both boxes' two slabs along an
+    /// axis in one register: the same `f32` operations, and SSE's min/max pick the same operand
+    /// as the portable form's comparisons, NaN included (`minps(x, y)` is `x < y ? x : y`).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn enter(&self, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> [Option<f32>; 2] {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 is baseline on x86-64; the loads read `[f32; 4]` arrays in full.
+        unsafe {
+            let widen = _mm_set1_ps(far_widen());
+            let mut t0 = _mm_setzero_ps();
+            let mut t1 = _mm_set1_ps(t_max);
+            for axis in 0..3 {
+                let s = _mm_loadu_ps(self.slabs[axis].as_ptr());
+                // Lanes: min 0, min 1, max 0, max 1.
+                let t = _mm_mul_ps(
+                    _mm_sub_ps(s, _mm_set1_ps(origin[axis])),
+                    _mm_set1_ps(inv_dir[axis]),
+                );
+                let a = t;
+                let b = _mm_movehl_ps(t, t);
+                // near = a > b ? b : a; far = a > b ? a : b.
+                let near = _mm_min_ps(b, a);
+                let far = _mm_mul_ps(_mm_max_ps(a, b), widen);
+                // t0 = near > t0 ? near : t0; t1 = far < t1 ? far : t1.
+                t0 = _mm_max_ps(near, t0);
+                t1 = _mm_min_ps(far, t1);
+            }
+            let hit = _mm_movemask_ps(_mm_cmple_ps(t0, t1));
+            let mut t = [0f32; 4];
+            _mm_storeu_ps(t.as_mut_ptr(), t0);
+            [
+                (hit & 1 != 0).then_some(t[0]),
+                (hit & 2 != 0).then_some(t[1]),
+            ]
+        }
     }
 }
 
 /// A bounding volume hierarchy over a list of triangles.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Bvh {
-    /// Sibling pairs in depth-first order; the root alone in the first. Node `i` is
-    /// `nodes[i / 2].0[i % 2]`.
-    nodes: Vec<NodePair>,
+    /// Sibling pairs in depth-first order; the root alone in the first. Node `i` is lane
+    /// `i % 2` of pair `i / 2`.
+    nodes: Vec<Pair>,
     /// Vertices in leaf order.
     vertices: Vec<[Vec3; 3]>,
     /// Scene index of each entry of `vertices`.
@@ -145,11 +239,11 @@ impl Bvh {
         let built = build::build(triangles);
         let vertices = built
             .order
-            .iter()
+            .par_iter()
             .map(|&i| triangles[i as usize].v)
             .collect();
         Bvh {
-            nodes: built.pairs,
+            nodes: built.pairs.into_par_iter().map(Pair::new).collect(),
             vertices,
             ids: built.order,
             depth: built.depth,
@@ -161,9 +255,14 @@ impl Bvh {
         (2 * self.nodes.len()).saturating_sub(1)
     }
 
-    #[inline(always)]
-    fn node(&self, i: usize) -> &Node {
-        &self.nodes[i >> 1].0[i & 1]
+    /// Every node (the root, then the pairs; not the root pair's filler).
+    fn all_nodes(&self) -> impl Iterator<Item = Node> {
+        self.nodes
+            .iter()
+            .flat_map(|p| [p.node(0), p.node(1)])
+            .enumerate()
+            .filter(|&(i, _)| i != 1)
+            .map(|(_, n)| n)
     }
 
     /// Number of levels (0 when empty, 1 for a single leaf).
@@ -171,29 +270,50 @@ impl Bvh {
         self.depth
     }
 
+    /// The tree's SAH cost: the expected number of box-pair and triangle tests for a random
+    /// ray that meets the root box (each node weighted by its area over the root's). Lower is
+    /// better; compare builds of one scene with it.
+    pub fn sah_cost(&self) -> f64 {
+        let area = |n: &Node| {
+            let d = (n.max - n.min).as_dvec3();
+            2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
+        };
+        let Some(root) = self.nodes.first().map(|p| p.node(0)) else {
+            return 0.0;
+        };
+        let root_area = area(&root);
+        if !(root_area > 0.0) {
+            return 0.0;
+        }
+        self.all_nodes()
+            .map(|n| {
+                let work = if n.is_leaf() { f64::from(n.count) } else { 1.0 };
+                work * area(&n) / root_area
+            })
+            .sum()
+    }
+
     /// Number of leaves.
     pub fn leaves(&self) -> usize {
-        (0..self.nodes())
-            .filter(|&i| self.node(i).is_leaf())
-            .count()
+        self.all_nodes().filter(|n| n.is_leaf()).count()
     }
 
     /// The closest hit with `t < t_max` (ties go to the lowest scene index), or `None`.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let root = &self.nodes.first()?.0[0];
-        let (o, inv) = (ray.origin, ray.inv_dir);
+        let root = self.nodes.first()?;
+        let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
         let mut bound = cull_bound(t_max);
-        root.enter(o, inv, bound)?;
+        root.enter(&o, &inv, bound)[0]?;
         let mut best: Option<Hit> = None;
         let mut tri_t_max = t_max;
         let mut stack = [(0u32, 0f32); MAX_DEPTH];
         let mut sp = 0;
         let mut i = 0usize;
         loop {
-            let node = self.node(i);
-            if node.is_leaf() {
-                let first = node.offset as usize;
-                for k in first..first + node.count as usize {
+            let (pair, lane) = (&self.nodes[i >> 1], i & 1);
+            let (offset, count) = (pair.offset[lane] as usize, pair.count[lane] as usize);
+            if count > 0 {
+                for k in offset..offset + count {
                     let Some(h) = intersect_watertight(ray, &self.vertices[k], tri_t_max) else {
                         continue;
                     };
@@ -209,11 +329,8 @@ impl Bvh {
                     }
                 }
             } else {
-                let a = node.offset as usize;
-                let b = a + 1;
-                let pair = &self.nodes[a >> 1].0;
-                let ta = pair[0].enter(o, inv, bound);
-                let tb = pair[1].enter(o, inv, bound);
+                let (a, b) = (offset, offset + 1);
+                let [ta, tb] = self.nodes[a >> 1].enter(&o, &inv, bound);
                 match (ta, tb) {
                     (Some(ta), Some(tb)) => {
                         // Nearer child first; the other waits with its entry distance.
@@ -251,33 +368,31 @@ impl Bvh {
 
     /// Whether some triangle has a hit with `t < t_max` (stops at the first found).
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        let Some(NodePair([root, _])) = self.nodes.first() else {
+        let Some(root) = self.nodes.first() else {
             return false;
         };
-        let (o, inv) = (ray.origin, ray.inv_dir);
+        let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
         let bound = cull_bound(t_max);
-        if root.enter(o, inv, bound).is_none() {
+        if root.enter(&o, &inv, bound)[0].is_none() {
             return false;
         }
         let mut stack = [0u32; MAX_DEPTH];
         let mut sp = 0;
         let mut i = 0usize;
         loop {
-            let node = self.node(i);
-            if node.is_leaf() {
-                let first = node.offset as usize;
-                if self.vertices[first..first + node.count as usize]
+            let (pair, lane) = (&self.nodes[i >> 1], i & 1);
+            let (offset, count) = (pair.offset[lane] as usize, pair.count[lane] as usize);
+            if count > 0 {
+                if self.vertices[offset..offset + count]
                     .iter()
                     .any(|v| intersect_watertight(ray, v, t_max).is_some())
                 {
                     return true;
                 }
             } else {
-                let a = node.offset as usize;
-                let b = a + 1;
-                let pair = &self.nodes[a >> 1].0;
-                let ha = pair[0].enter(o, inv, bound).is_some();
-                let hb = pair[1].enter(o, inv, bound).is_some();
+                let (a, b) = (offset, offset + 1);
+                let [ta, tb] = self.nodes[a >> 1].enter(&o, &inv, bound);
+                let (ha, hb) = (ta.is_some(), tb.is_some());
                 if ha {
                     if hb {
                         stack[sp] = b as u32;
@@ -312,6 +427,47 @@ mod tests {
     }
 
     #[test]
+    fn both_slab_tests_agree() {
+        // Random boxes and rays, with axis-parallel rays and origins on slab planes mixed in
+        // (the NaN cases), compared bit for bit.
+        let mut rng = crate::rng::Rng::seeded(5);
+        let mut f = |scale: f32| (rng.next_f32() * 2.0 - 1.0) * scale;
+        for i in 0..20_000 {
+            let lo = [0, 1].map(|_| Vec3::new(f(1.0), f(1.0), f(1.0)));
+            let hi = lo.map(|l| l + Vec3::new(f(1.0).abs(), f(1.0).abs(), f(1.0).abs()));
+            let node = |k: usize| Node {
+                min: lo[k],
+                offset: 0,
+                max: hi[k],
+                count: 1,
+            };
+            let pair = Pair::new(NodePair([node(0), node(1)]));
+            let mut origin = Vec3::new(f(2.0), f(2.0), f(2.0));
+            let mut dir = Vec3::new(f(1.0), f(1.0), f(1.0));
+            if i % 3 == 0 {
+                dir[i % 9 / 3] = 0.0;
+                origin[i % 9 / 3] = if i % 2 == 0 {
+                    lo[0][i % 9 / 3]
+                } else {
+                    hi[1][i % 9 / 3]
+                };
+            }
+            if dir == Vec3::ZERO {
+                continue;
+            }
+            let ray = Ray::new(origin, dir);
+            let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
+            for t_max in [f32::INFINITY, f(3.0).abs()] {
+                let a = pair.enter(&o, &inv, t_max).map(|t| t.map(f32::to_bits));
+                let b = pair
+                    .enter_portable(&o, &inv, t_max)
+                    .map(|t| t.map(f32::to_bits));
+                assert_eq!(a, b, "{ray:?} {t_max} {pair:?}");
+            }
+        }
+    }
+
+    #[test]
     fn nan_slab_distances_keep_the_box() {
         let node = Node {
             min: Vec3::new(0.0, -1.0, 1.0),
@@ -319,17 +475,22 @@ mod tests {
             max: Vec3::new(1.0, 1.0, 2.0),
             count: 1,
         };
+        // Both lanes hold the box: they must agree.
+        let pair = Pair::new(NodePair([node; 2]));
+        assert_eq!(pair.node(1), node);
+        let node = |o: Vec3, inv: Vec3, t_max| {
+            let [a, b] = pair.enter(&o.to_array(), &inv.to_array(), t_max);
+            assert_eq!(a, b);
+            a
+        };
         // Origin on the x = 0 face, ray along +z: (0 − 0)·∞ is NaN.
         let ray = Ray::new(Vec3::ZERO, Vec3::Z);
-        assert_eq!(
-            node.enter(ray.origin, ray.inv_dir, f32::INFINITY),
-            Some(1.0)
-        );
+        assert_eq!(node(ray.origin, ray.inv_dir, f32::INFINITY), Some(1.0));
         // Beside the box and parallel to its faces: missed.
         let ray = Ray::new(Vec3::new(-0.5, 0.0, 0.0), Vec3::Z);
-        assert_eq!(node.enter(ray.origin, ray.inv_dir, f32::INFINITY), None);
+        assert_eq!(node(ray.origin, ray.inv_dir, f32::INFINITY), None);
         // Beyond t_max: missed.
         let ray = Ray::new(Vec3::new(0.5, 0.0, 0.0), Vec3::Z);
-        assert_eq!(node.enter(ray.origin, ray.inv_dir, 0.5), None);
+        assert_eq!(node(ray.origin, ray.inv_dir, 0.5), None);
     }
 }

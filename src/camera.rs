@@ -30,12 +30,12 @@ impl Default for Camera {
 impl Camera {
     /// The seed's rotation R = [[cos θ, 0, sin θ], [0, 1, 0], [−sin θ, 0, cos θ]] times the pitch.
     pub fn rotation(&self) -> Mat3 {
-        let (s, c) = self.yaw.sin_cos();
+        let (s, c) = (libm::sinf(self.yaw), libm::cosf(self.yaw));
         let yaw = Mat3::from_cols(Vec3::new(c, 0.0, -s), Vec3::Y, Vec3::new(s, 0.0, c));
         if self.pitch == 0.0 {
             return yaw;
         }
-        let (s, c) = self.pitch.sin_cos();
+        let (s, c) = (libm::sinf(self.pitch), libm::cosf(self.pitch));
         let pitch = Mat3::from_cols(Vec3::X, Vec3::new(0.0, c, -s), Vec3::new(0.0, s, c));
         yaw * pitch
     }

@@ -15,7 +15,7 @@ use raytty::{CellGrid, ColorMode, PointLight, Scene, Stage, encode_text, render}
 /// Renders the Cornell box (or another scene) by ray tracing, in the terminal.
 ///
 /// With no command on a terminal, raytty runs the interactive app; when stdout is not a
-/// terminal it prints one frame, as `raytty render` would. Frames are truecolor half-blocks:
+/// terminal (or TERM is dumb) it prints one frame, as `raytty render` would. Frames are truecolor half-blocks:
 /// each cell shows two pixels, so an 80×24 frame is 80×48 pixels.
 #[derive(Parser, Debug)]
 #[command(name = "raytty", version, about, long_about)]
@@ -122,18 +122,24 @@ enum Format {
 /// Options of `raytty render`.
 #[derive(Args, Debug)]
 struct RenderArgs {
-    /// Frame size in terminal cells, COLSxROWS (text formats: COLS × 2·ROWS pixels).
-    #[arg(long, value_name = "COLSxROWS", value_parser = parse_size, default_value = "80x24")]
-    size: (u32, u32),
+    /// Frame size in terminal cells, COLSxROWS: COLS × 2·ROWS pixels (default 80x24 for text;
+    /// images default to 500x500 pixels unless --size or --pixels is given).
+    #[arg(long, value_name = "COLSxROWS", value_parser = parse_size)]
+    size: Option<(u32, u32)>,
     /// Image size in pixels, WxH (default 500x500 for png and pfm; overrides --size).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pixels: Option<(u32, u32)>,
-    /// Output format (default: from the -o file's extension, .png or .pfm; else ansi).
+    /// Output format (default: from the -o file's extension, .png or .pfm; else ansi, or
+    /// ascii if NO_COLOR is set).
     #[arg(long, value_enum)]
     format: Option<Format>,
     /// Shading stage: flat, light, direct, shadows, indirect (the default) or gi.
     #[arg(long, value_parser = parse_stage, default_value = "indirect")]
     stage: Stage,
+    /// Samples per pixel, 1 to 1024, spread over the pixel: smooth edges, and far less noise
+    /// in the gi stage (one sample is noisy). Default: the scene's (1 for gi).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    samples: Option<u32>,
     /// Camera position and yaw in degrees, x,y,z,yaw (default: the scene's camera).
     #[arg(long, value_name = "X,Y,Z,YAW", value_parser = parse_camera, allow_hyphen_values = true)]
     camera: Option<[f32; 4]>,
@@ -210,9 +216,10 @@ pub fn main() -> ExitCode {
         cmd = cmd.after_long_help(crate::tui::keys::help_text());
     }
     let cli = Cli::from_arg_matches(&cmd.get_matches()).unwrap_or_else(|e| e.exit());
+    let dumb = is_dumb(std::env::var("TERM").ok().as_deref());
     let color = resolve_color(
         cli.color,
-        std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty()),
+        dumb || std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty()),
         std::env::var("COLORTERM").ok().as_deref(),
     );
     let result = match cli.command {
@@ -224,13 +231,13 @@ pub fn main() -> ExitCode {
             .map(|()| ExitCode::SUCCESS)
             .map_err(Into::into),
         Some(Command::Bench(a)) => run_bench(a, cli.scene.as_deref()).map(|()| ExitCode::SUCCESS),
-        None => run_default(color, cli.scene.as_deref()),
+        None => run_default(color, cli.scene.as_deref(), dumb),
     };
     match result {
         Ok(code) => code,
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("raytty: {e:#}");
+            eprintln!("raytty: {}", without_os_error(&format!("{e:#}")));
             ExitCode::from(if e.downcast_ref::<UsageError>().is_some() {
                 2
             } else {
@@ -244,13 +251,31 @@ pub fn main() -> ExitCode {
 /// `--scene`, what that scene costs (load and acceleration build, frame times, M rays/s).
 fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
     if let Some(name) = scene {
+        // These shape the accuracy bench only: refuse them rather than ignore them.
+        let unused: Vec<&str> = [
+            (a.csv, "--csv"),
+            (a.svg.is_some(), "--svg"),
+            (a.readme.is_some(), "--readme"),
+            (a.max_spp.is_some(), "--max-spp"),
+            (a.ref_spp.is_some(), "--ref-spp"),
+            (a.ref_bounces.is_some(), "--ref-bounces"),
+        ]
+        .into_iter()
+        .filter_map(|(given, flag)| given.then_some(flag))
+        .collect();
+        if !unused.is_empty() {
+            bail!(UsageError(format!(
+                "{} belong to the accuracy bench (no --scene); with --scene, bench times frames: --sizes, --runs, --quick",
+                unused.join(", ")
+            )));
+        }
         let start = std::time::Instant::now();
         let scene = crate::scene_arg::load_scene(Some(name))?;
         let load = start.elapsed();
-        let sizes = if a.sizes.is_empty() {
-            vec![(200, 100), (500, 500)]
-        } else {
-            a.sizes
+        let sizes = match (a.sizes.is_empty(), a.quick) {
+            (false, _) => a.sizes,
+            (true, true) => raytty::bench::BenchOptions::quick().sizes,
+            (true, false) => vec![(200, 100), (500, 500)],
         };
         let runs = a.runs.unwrap_or(if a.quick { 2 } else { 5 });
         let report = raytty::scene_bench::bench_scene(&scene, &sizes, runs);
@@ -263,6 +288,17 @@ fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
         )?;
         out.write_all(report.to_markdown().as_bytes())?;
         return Ok(());
+    }
+    // The plot is written after the (long) run: a folder that does not exist fails now.
+    if let Some(dir) = a.svg.as_deref().and_then(std::path::Path::parent)
+        && !dir.as_os_str().is_empty()
+        && !dir.is_dir()
+    {
+        bail!(UsageError(format!(
+            "--svg {}: the folder {} does not exist",
+            a.svg.as_deref().unwrap_or(dir).display(),
+            dir.display()
+        )));
     }
     let request = raytty::bench::BenchRequest {
         quick: a.quick,
@@ -287,7 +323,8 @@ fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
     )
     .map_err(|e| match e {
         raytty::bench::BenchError::Usage(m) => UsageError(m).into(),
-        e => anyhow::Error::new(e),
+        // The I/O error as the cause, said once (BenchError's own text repeats it).
+        raytty::bench::BenchError::Io { what, error } => anyhow::Error::new(error).context(what),
     })
 }
 
@@ -310,16 +347,40 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
     })
 }
 
-/// No command: the app on a terminal; otherwise one frame to stdout, as `raytty render` with
-/// its defaults would print in `color`.
-fn run_default(color: ColorMode, scene: Option<&str>) -> Result<ExitCode> {
+/// Whether `TERM` names a terminal that cannot move its cursor (`dumb`, as in Emacs' shell):
+/// the app cannot draw there, and auto colour means none.
+fn is_dumb(term: Option<&str>) -> bool {
+    term == Some("dumb")
+}
+
+/// No command: the app on a terminal; otherwise (or on a dumb terminal) one frame to stdout,
+/// as `raytty render` with its defaults would print in `color`.
+fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<ExitCode> {
     #[cfg(feature = "tui")]
     if io::stdout().is_terminal() {
-        return crate::tui::run(crate::scene_arg::load_scene(scene)?, color);
+        if !dumb {
+            // A big scene takes seconds to generate and build: say so rather than show a
+            // blank terminal, then erase the line before the app (or an error) takes over.
+            let note = io::stderr().is_terminal();
+            if note {
+                eprint!(
+                    "raytty: loading {}…",
+                    raytty::printable(scene.unwrap_or("the Cornell box"))
+                );
+            }
+            let loaded = crate::scene_arg::load_scene(scene);
+            if note {
+                eprint!("\r\x1b[2K");
+            }
+            return crate::tui::run(loaded?, color);
+        }
+        eprintln!("raytty: TERM=dumb cannot run the app (it moves the cursor): one frame follows");
     }
+    #[cfg(not(feature = "tui"))]
+    let _ = dumb;
     run_render(
         &RenderArgs {
-            size: (80, 24),
+            size: Some((80, 24)),
             pixels: None,
             format: Some(match color {
                 ColorMode::TrueColor => Format::Ansi,
@@ -327,6 +388,7 @@ fn run_default(color: ColorMode, scene: Option<&str>) -> Result<ExitCode> {
                 ColorMode::Ascii => Format::Ascii,
             }),
             stage: Stage::Indirect,
+            samples: None,
             camera: None,
             light: None,
             output: None,
@@ -337,19 +399,43 @@ fn run_default(color: ColorMode, scene: Option<&str>) -> Result<ExitCode> {
 }
 
 fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
-    let format = args
-        .format
-        .unwrap_or_else(|| format_for(args.output.as_deref()));
+    if let Some(ext) = args.output.as_deref().and_then(unwritable_image_extension) {
+        bail!(UsageError(format!(
+            "-o {}: raytty cannot write .{ext} images: use a .png or .pfm file name (or --format ascii|ansi|ansi256 for text)",
+            args.output
+                .as_deref()
+                .unwrap_or_else(|| "".as_ref())
+                .display()
+        )));
+    }
+    let format = args.format.unwrap_or_else(|| {
+        let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
+        match format_for(args.output.as_deref()) {
+            Format::Ansi if no_color => Format::Ascii,
+            f => f,
+        }
+    });
     let image_format = matches!(format, Format::Png | Format::Pfm);
-    let (w, h) = match (args.pixels, image_format) {
-        (Some(p), _) => p,
-        (None, true) => (500, 500),
-        (None, false) => (args.size.0, args.size.1 * 2),
+    if image_format && args.output.is_none() && io::stdout().is_terminal() {
+        bail!(UsageError(format!(
+            "--format {} writes binary data: give -o FILE or redirect stdout",
+            format_name(format)
+        )));
+    }
+    let (w, h) = match (args.pixels, args.size, image_format) {
+        (Some(p), _, _) => p,
+        (None, Some((cols, rows)), _) => (cols, rows * 2),
+        (None, None, true) => (500, 500),
+        (None, None, false) => (80, 48),
     };
     let pixels = w as u64 * h as u64;
     if pixels > MAX_PIXELS {
+        let asked = match args.pixels {
+            Some(_) => format!("--pixels {w}x{h} is"),
+            None => format!("--size {}x{} is {w}x{h} =", w, h / 2),
+        };
         bail!(UsageError(format!(
-            "--pixels {w}x{h} is {pixels} pixels, about {} MiB of memory; the limit is {MAX_PIXELS} pixels (e.g. 8192x8192)",
+            "{asked} {pixels} pixels, about {} MiB of memory; the limit is {MAX_PIXELS} pixels (e.g. --pixels 8192x8192 or --size 8192x4096)",
             pixels * 48 / (1024 * 1024)
         )));
     }
@@ -359,38 +445,64 @@ fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
         camera.position = Vec3::new(x, y, z);
         camera.yaw = yaw.to_radians();
     }
+    if args.light.is_some() && scene.lights.is_empty() {
+        bail!(UsageError(
+            "--light moves the scene's first light, and this scene has none: add a [[light]] to the scene file".into()
+        ));
+    }
     let lights = lights_with(&scene, args.light);
-    let settings = args.stage.settings(scene.effects);
-    let frame = render(&scene, &camera, &lights, &settings, w, h);
-
+    let mut settings = args.stage.settings(scene.effects);
+    if let Some(n) = args.samples {
+        settings.effects.samples = n;
+    }
+    // The output file is created before the (maybe long) render, so a bad path fails at once.
     let mut out: Box<dyn Write> = match &args.output {
         Some(path) => Box::new(BufWriter::new(
             File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
         )),
-        None => {
-            if image_format && io::stdout().is_terminal() {
-                bail!(UsageError(format!(
-                    "--format {:?} writes binary data: give -o FILE or redirect stdout",
-                    format
-                )));
-            }
-            Box::new(BufWriter::new(io::stdout().lock()))
-        }
+        None => Box::new(BufWriter::new(io::stdout().lock())),
     };
-    match format {
-        Format::Png => frame.image.write_png(&mut out)?,
-        Format::Pfm => frame.image.write_pfm(&mut out)?,
+    let frame = render(&scene, &camera, &lights, &settings, w, h);
+    let written = match format {
+        Format::Png => frame.image.write_png(&mut out),
+        Format::Pfm => frame.image.write_pfm(&mut out),
         Format::Ansi | Format::Ansi256 | Format::Ascii => {
             let mode = match format {
                 Format::Ansi => ColorMode::TrueColor,
                 Format::Ansi256 => ColorMode::Ansi256,
                 _ => ColorMode::Ascii,
             };
-            out.write_all(&encode_text(&CellGrid::from_image(&frame.image, mode)))?;
+            out.write_all(&encode_text(&CellGrid::from_image(&frame.image, mode)))
+        }
+    };
+    written.and_then(|()| out.flush()).with_context(|| {
+        format!(
+            "cannot write to {}",
+            args.output
+                .as_ref()
+                .map_or_else(|| "stdout".to_string(), |p| p.display().to_string())
+        )
+    })
+}
+
+/// `message` without the " (os error N)" that Rust's I/O errors end with: the words before it
+/// say it all, and the number means nothing to a user.
+fn without_os_error(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(i) = rest.find(" (os error ") {
+        let after = &rest[i + " (os error ".len()..];
+        let digits = after.chars().take_while(char::is_ascii_digit).count();
+        if digits > 0 && after[digits..].starts_with(')') {
+            out.push_str(&rest[..i]);
+            rest = &after[digits + 1..];
+        } else {
+            out.push_str(&rest[..i + 1]);
+            rest = &rest[i + 1..];
         }
     }
-    out.flush()?;
-    Ok(())
+    out.push_str(rest);
+    out
 }
 
 /// The format an output file's extension implies: `.png` and `.pfm` are images, anything else
@@ -405,6 +517,23 @@ fn format_for(output: Option<&std::path::Path>) -> Format {
         Some("pfm") => Format::Pfm,
         _ => Format::Ansi,
     }
+}
+
+/// The extension of an image format raytty cannot write (`jpg`, `gif`, …), so that `-o
+/// box.jpg` is refused instead of filled with terminal text.
+fn unwritable_image_extension(path: &std::path::Path) -> Option<String> {
+    const IMAGES: [&str; 12] = [
+        "jpg", "jpeg", "gif", "bmp", "tif", "tiff", "webp", "avif", "heic", "exr", "hdr", "ppm",
+    ];
+    let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+    IMAGES.contains(&ext.as_str()).then_some(ext)
+}
+
+/// A format's name as `--format` spells it.
+fn format_name(format: Format) -> String {
+    format
+        .to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_string())
 }
 
 /// The scene's lights, with the first one moved to `light` if given.
@@ -427,6 +556,32 @@ mod tests {
         assert_eq!(format_for(Some(Path::new("dir/A.PFM"))), Format::Pfm);
         assert_eq!(format_for(Some(Path::new("frame.txt"))), Format::Ansi);
         assert_eq!(format_for(None), Format::Ansi);
+        assert_eq!(
+            unwritable_image_extension(Path::new("box.JPG")).as_deref(),
+            Some("jpg")
+        );
+        assert_eq!(unwritable_image_extension(Path::new("box.png")), None);
+        assert_eq!(unwritable_image_extension(Path::new("frame.txt")), None);
+        assert_eq!(unwritable_image_extension(Path::new("frame")), None);
+        assert_eq!(format_name(Format::Png), "png");
+    }
+
+    #[test]
+    fn os_error_numbers_are_dropped_from_messages() {
+        assert_eq!(
+            without_os_error("cannot create x: No such file or directory (os error 2)"),
+            "cannot create x: No such file or directory"
+        );
+        assert_eq!(without_os_error("a (os error 2); b (os error 28)"), "a; b");
+        assert_eq!(without_os_error("kept (os error x)"), "kept (os error x)");
+    }
+
+    #[test]
+    fn a_dumb_terminal_is_recognised() {
+        assert!(is_dumb(Some("dumb")));
+        assert!(!is_dumb(Some("xterm-256color")));
+        assert!(!is_dumb(Some("")));
+        assert!(!is_dumb(None));
     }
 
     #[test]

@@ -42,10 +42,10 @@ impl Image {
         let mut enc = png::Encoder::new(w, self.width, self.height);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
-        let mut writer = enc.write_header().map_err(io::Error::other)?;
+        let mut writer = enc.write_header().map_err(png_io_error)?;
         let data: Vec<u8> = self.to_rgb8().into_iter().flatten().collect();
-        writer.write_image_data(&data).map_err(io::Error::other)?;
-        writer.finish().map_err(io::Error::other)
+        writer.write_image_data(&data).map_err(png_io_error)?;
+        writer.finish().map_err(png_io_error)
     }
 
     /// Writes a PFM: linear little-endian f32 RGB, bottom row first, as the format requires.
@@ -73,4 +73,38 @@ pub fn to_rgb8(p: Vec3) -> [u8; 3] {
             0
         }
     })
+}
+
+/// The encoder's error as an I/O error, keeping the writer's own error (and so its kind: a
+/// closed pipe stays `BrokenPipe`, which the command line treats as success).
+fn png_io_error(e: png::EncodingError) -> io::Error {
+    match e {
+        png::EncodingError::IoError(e) => e,
+        e => io::Error::other(e),
+    }
+}
+
+#[cfg(test)]
+mod png_tests {
+    use super::*;
+
+    /// A writer whose reader has gone away.
+    struct ClosedPipe;
+
+    impl Write for ClosedPipe {
+        fn write(&mut self, _: &[u8]) -> io::Result<usize> {
+            Err(io::ErrorKind::BrokenPipe.into())
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_closed_pipe_stays_a_broken_pipe() {
+        let e = Image::new(4, 4).write_png(ClosedPipe).unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::BrokenPipe);
+        let e = Image::new(4, 4).write_pfm(ClosedPipe).unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::BrokenPipe);
+    }
 }

@@ -5,6 +5,10 @@
 //! back from the last vertex read. Polygons are fanned into triangles from their first vertex.
 //! Every other statement (`vt`, `vn`, `o`, `g`, `s`, `usemtl`, `mtllib`, `l`, ...) is ignored.
 //! Every error names its line and column.
+//!
+//! Why not the `tobj` crate: its errors say what went wrong but not where, and every mistake in
+//! a user's file must name its line and column; it also loads materials and texture
+//! coordinates that the tracer has no use for. What raytty needs of OBJ fits in this file.
 
 use glam::Vec3;
 

@@ -9,10 +9,34 @@
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
-/// The icosahedron's 12 vertices (not normalised) and 20 faces.
-fn icosahedron() -> ([DVec3; 12], [[usize; 3]; 20]) {
+/// The icosahedron's 20 faces, as indices into [`icosahedron_vertices`], wound consistently.
+pub const ICOSAHEDRON_FACES: [[usize; 3]; 20] = [
+    [0, 11, 5],
+    [0, 5, 1],
+    [0, 1, 7],
+    [0, 7, 10],
+    [0, 10, 11],
+    [1, 5, 9],
+    [5, 11, 4],
+    [11, 10, 2],
+    [10, 7, 6],
+    [7, 1, 8],
+    [3, 9, 4],
+    [3, 4, 2],
+    [3, 2, 6],
+    [3, 6, 8],
+    [3, 8, 9],
+    [4, 9, 5],
+    [2, 4, 11],
+    [6, 2, 10],
+    [8, 6, 7],
+    [9, 8, 1],
+];
+
+/// The icosahedron's 12 vertices (golden-ratio rectangles, not normalised).
+pub fn icosahedron_vertices() -> [DVec3; 12] {
     let p = (1.0 + 5f64.sqrt()) / 2.0;
-    let v = [
+    [
         DVec3::new(-1.0, p, 0.0),
         DVec3::new(1.0, p, 0.0),
         DVec3::new(-1.0, -p, 0.0),
@@ -25,36 +49,14 @@ fn icosahedron() -> ([DVec3; 12], [[usize; 3]; 20]) {
         DVec3::new(p, 0.0, 1.0),
         DVec3::new(-p, 0.0, -1.0),
         DVec3::new(-p, 0.0, 1.0),
-    ];
-    let f = [
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    (v, f)
+    ]
 }
 
 /// A smooth, deterministic bump field on the unit sphere, in [-1, 1].
 fn bumps(d: DVec3) -> f64 {
-    let a = (5.0 * d.x + 1.3).sin() * (4.0 * d.y - 0.7).sin() * (6.0 * d.z + 0.4).sin();
-    let b = (13.0 * d.x - 2.0 * d.z).sin() * (11.0 * d.y + 3.0 * d.x).sin();
+    use libm::sin;
+    let a = sin(5.0 * d.x + 1.3) * sin(4.0 * d.y - 0.7) * sin(6.0 * d.z + 0.4);
+    let b = sin(13.0 * d.x - 2.0 * d.z) * sin(11.0 * d.y + 3.0 * d.x);
     (0.7 * a + 0.3 * b).clamp(-1.0, 1.0)
 }
 
@@ -69,7 +71,7 @@ pub fn icosphere_triangles(k: u32) -> u64 {
 pub fn displaced_icosphere(k: u32, amplitude: f32) -> Vec<[Vec3; 3]> {
     let k = k.max(1) as usize;
     let amplitude = f64::from(amplitude);
-    let (corners, faces) = icosahedron();
+    let corners = icosahedron_vertices();
     let vertex = |face: [usize; 3], i: usize, j: usize| -> Vec3 {
         // Weights as exact integer ratios, summed in the order of the corners' indices so that
         // a point on a shared edge comes out bit-identical from both faces.
@@ -85,7 +87,7 @@ pub fn displaced_icosphere(k: u32, amplitude: f32) -> Vec<[Vec3; 3]> {
         let d = p.normalize();
         (d * (1.0 + amplitude * bumps(d))).as_vec3()
     };
-    faces
+    ICOSAHEDRON_FACES
         .par_iter()
         .flat_map_iter(|&face| {
             let mut out = Vec::with_capacity(k * k);

@@ -3,6 +3,7 @@
 //! finite position and non-negative power, so rendering it cannot fail.
 
 use std::ops::Range;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -153,6 +154,13 @@ pub struct SceneBuilder {
     accel: Option<AccelKind>,
 }
 
+/// Stands in for a degenerate triangle while validating; never part of a scene.
+const PLACEHOLDER: Triangle = Triangle {
+    v: [Vec3::ZERO; 3],
+    normal: Vec3::Z,
+    material: 0,
+};
+
 impl SceneBuilder {
     /// An empty builder.
     pub fn new() -> SceneBuilder {
@@ -188,26 +196,28 @@ impl SceneBuilder {
     /// Validates and builds the scene. Triangles are checked in parallel; the error names the
     /// first bad one in the order added.
     pub fn build(self, name: &str, camera: Camera, effects: Effects) -> Result<Scene, SceneError> {
-        let triangles: Vec<Triangle> = match self
-            .raw
+        // Validated in parallel straight into place (an indexed collect: no intermediate
+        // lists); a failure only raises a flag, and then a sequential pass finds the first.
+        let failed = AtomicBool::new(false);
+        let mut triangles = Vec::new();
+        self.raw
             .par_iter()
-            .map(|&([a, b, c], m)| Triangle::new(a, b, c, m))
-            .collect::<Result<Vec<_>, _>>()
-        {
-            Ok(t) => t,
-            Err(_) => {
-                // Which one failed first: only on this error path, so sequential is fine.
-                let (index, problem) = self
-                    .raw
-                    .iter()
-                    .enumerate()
-                    .find_map(|(i, &([a, b, c], m))| {
-                        Triangle::new(a, b, c, m).err().map(|e| (i, e))
-                    })
-                    .expect("a triangle failed to validate");
-                return Err(SceneError::Triangle { index, problem });
-            }
-        };
+            .map(|&([a, b, c], m)| {
+                Triangle::new(a, b, c, m).unwrap_or_else(|_| {
+                    failed.store(true, Ordering::Relaxed);
+                    PLACEHOLDER
+                })
+            })
+            .collect_into_vec(&mut triangles);
+        if failed.into_inner() {
+            let (index, problem) = self
+                .raw
+                .iter()
+                .enumerate()
+                .find_map(|(i, &([a, b, c], m))| Triangle::new(a, b, c, m).err().map(|e| (i, e)))
+                .expect("a triangle failed to validate");
+            return Err(SceneError::Triangle { index, problem });
+        }
         let materials = self.materials.len();
         if let Some(index) = triangles
             .par_iter()

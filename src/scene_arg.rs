@@ -15,16 +15,42 @@ pub fn load_scene(arg: Option<&str>) -> Result<Scene> {
         return Ok(raytty::cornell_box());
     };
     let path = Path::new(arg);
-    if path.exists() || arg.ends_with(".toml") {
+    let builtins = || builtin::names().join(", ");
+    if path.is_dir() {
+        bail!(UsageError(format!(
+            "--scene {}: is a folder: give the path of a .toml scene file (or a built-in scene: {})",
+            printable(arg),
+            builtins()
+        )));
+    }
+    if !path.exists() && arg.ends_with(".toml") {
+        bail!(UsageError(format!(
+            "--scene {}: no such file: give the path of an existing .toml scene file (or a built-in scene: {})",
+            printable(arg),
+            builtins()
+        )));
+    }
+    if arg.to_ascii_lowercase().ends_with(".obj") {
+        bail!(UsageError(format!(
+            "--scene {}: an OBJ mesh is not a scene: write a .toml scene with an [[object]] of kind = \"obj\" and path = \"{}\" (scenes/example.toml shows one)",
+            printable(arg),
+            printable(
+                &path
+                    .file_name()
+                    .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+            )
+        )));
+    }
+    if path.exists() {
         return scenefile::load(path).map_err(|e| UsageError(e.to_string()).into());
     }
     match builtin::find(arg) {
         Some(b) => b.load().map_err(|e| UsageError(e.to_string()).into()),
         None => bail!(UsageError(format!(
-            "--scene {}: no such file and no built-in scene of that name{}; built-in scenes: {} (or give a path to a .toml scene file)",
+            "--scene {}: no such file and no built-in scene of that name{} (built-in scenes: {}; or give the path of a .toml scene file)",
             printable(arg),
             scenefile::did_you_mean(arg, &builtin::names()),
-            builtin::names().join(", ")
+            builtins()
         ))),
     }
 }

@@ -3,11 +3,14 @@
 //! [`SceneFileError`] naming the file, line and column, what was wrong and what would be right.
 //! `scenes/example.toml` documents every key.
 //!
-//! A file that loads is a valid [`Scene`]: it goes through [`SceneBuilder`], and everything the
-//! builder would reject (degenerate triangles, bad lights) is caught first, here, with a line.
+//! A file that loads is a valid [`Scene`]: it goes through [`crate::SceneBuilder`], and everything
+//! the builder would reject (degenerate triangles, bad lights) is caught first, here, with a
+//! line.
 
 mod build;
+mod check;
 mod error;
+mod objects;
 mod spec;
 
 use std::io::Read;
@@ -54,8 +57,8 @@ pub type MeshReader<'a> = &'a dyn Fn(&str) -> Result<(String, Vec<u8>), String>;
 /// named by the file's `name` key, or else by the file's stem.
 pub fn load(path: &Path) -> Result<Scene, SceneFileError> {
     let shown = path.display().to_string();
-    let bytes =
-        read_capped(path, MAX_SCENE_BYTES).map_err(|e| SceneFileError::whole_file(&shown, e))?;
+    let bytes = read_capped(path, MAX_SCENE_BYTES)
+        .map_err(|e| SceneFileError::whole_file(&shown, format!("the scene file {e}")))?;
     let source = String::from_utf8(bytes).map_err(|e| {
         let offset = e.utf8_error().valid_up_to();
         let text = String::from_utf8_lossy(e.as_bytes());
@@ -69,7 +72,8 @@ pub fn load(path: &Path) -> Result<Scene, SceneFileError> {
     let base = path.parent().unwrap_or(Path::new(""));
     let read_mesh = |p: &str| {
         let full = base.join(p);
-        let bytes = read_capped(&full, MAX_MESH_BYTES)?;
+        let bytes =
+            read_capped(&full, MAX_MESH_BYTES).map_err(|e| format!("{} {e}", full.display()))?;
         Ok((full.display().to_string(), bytes))
     };
     let stem = path
@@ -97,20 +101,17 @@ pub fn no_meshes(path: &str) -> Result<(String, Vec<u8>), String> {
     ))
 }
 
-/// Reads at most `limit` bytes of `path`; more is an error.
+/// Reads at most `limit` bytes of `path`. The error completes a sentence that starts with
+/// what the file is: "cannot be read: ..." or "is larger than ...".
 fn read_capped(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
-    let file =
-        std::fs::File::open(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let unreadable = |e: std::io::Error| format!("cannot be read: {e}");
+    let file = std::fs::File::open(path).map_err(unreadable)?;
     let mut bytes = Vec::new();
     file.take(limit + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+        .map_err(unreadable)?;
     if bytes.len() as u64 > limit {
-        return Err(format!(
-            "{} is larger than {} MiB, the limit",
-            path.display(),
-            limit >> 20
-        ));
+        return Err(format!("is larger than {} MiB, the limit", limit >> 20));
     }
     Ok(bytes)
 }

@@ -310,7 +310,7 @@ fn cosine_sample(n: Vec3, rng: &mut Rng) -> Vec3 {
     let (u1, u2) = (rng.next_f32(), rng.next_f32());
     let r = u1.sqrt();
     let phi = 2.0 * PI * u2;
-    let (s, c) = phi.sin_cos();
+    let (s, c) = (libm::sinf(phi), libm::cosf(phi));
     let (t, b) = n.any_orthonormal_pair();
     (t * (r * c) + b * (r * s) + n * (1.0 - u1).max(0.0).sqrt()).normalize()
 }

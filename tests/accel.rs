@@ -339,6 +339,18 @@ fn leaves_hold_a_few_triangles() {
         (1.0..=raytty::bvh::LEAF_MAX as f64).contains(&per_leaf),
         "{per_leaf} triangles per leaf"
     );
+    // A binary tree: one more leaf than interior nodes.
+    assert_eq!(bvh.nodes(), 2 * bvh.leaves() - 1);
+    let cost = bvh.sah_cost();
+    assert!(cost.is_finite() && cost > 1.0, "SAH cost {cost}");
     // A well-balanced tree over 18000 triangles is a few dozen levels at most.
     assert!(bvh.depth() < 40, "depth {}", bvh.depth());
+}
+
+/// The 1M-triangle sphere (k = 224) against brute force: slow (each brute-force ray tests a
+/// million triangles; 17 s here), so run by hand: `cargo test --test accel -- --ignored`.
+#[test]
+#[ignore]
+fn million_triangle_icosphere_matches_brute_force() {
+    assert_exact(displaced_icosphere(224, 0.08), 41, 300, 2.0);
 }

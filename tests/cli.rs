@@ -57,6 +57,11 @@ fn images_are_written_to_files() {
     let bytes = std::fs::read(&pfm).unwrap();
     assert!(bytes.starts_with(b"PF\n64 32\n-1.0\n"));
     assert_eq!(bytes.len(), "PF\n64 32\n-1.0\n".len() + 64 * 32 * 12);
+    // --size gives an image the pixels of that many cells; the extension picks the format.
+    let sized = dir.join("cells.pfm");
+    let out = raytty(&["render", "--size", "20x6", "-o", sized.to_str().unwrap()]);
+    assert!(out.status.success());
+    assert!(std::fs::read(&sized).unwrap().starts_with(b"PF\n20 12\n"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -109,6 +114,27 @@ fn bad_values_get_a_clear_message_and_status_2() {
             ],
             "limit",
         ),
+        (
+            &["render", "--size", "65535x65535"],
+            "--size 65535x65535 is 65535x131070 = ",
+        ),
+        (
+            &["render", "-o", "/nonexistent/box.jpg"],
+            "cannot write .jpg",
+        ),
+        (
+            &["--scene", "/nonexistent/box.toml", "render"],
+            "--scene /nonexistent/box.toml: no such file: give the path of an existing .toml",
+        ),
+        (&["--scene", "/", "render"], "--scene /: is a folder"),
+        (
+            &["--scene", "scenes/tetrahedron.obj", "render"],
+            "an OBJ mesh is not a scene: write a .toml scene with an [[object]] of kind = \"obj\" and path = \"tetrahedron.obj\"",
+        ),
+        (
+            &["--scene", "Cornell", "render"],
+            "name; did you mean `cornell`? (built-in scenes: cornell, ",
+        ),
     ] {
         let out = raytty(args);
         let err = String::from_utf8_lossy(&out.stderr);
@@ -116,4 +142,169 @@ fn bad_values_get_a_clear_message_and_status_2() {
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
+}
+
+#[test]
+fn no_color_makes_the_default_text_format_ascii() {
+    let run = |no_color: bool, args: &[&str]| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_raytty"));
+        cmd.args(["render", "--size", "12x4"]).args(args);
+        if no_color {
+            cmd.env("NO_COLOR", "1");
+        } else {
+            cmd.env_remove("NO_COLOR");
+        }
+        let out = cmd.output().unwrap();
+        assert!(out.status.success());
+        String::from_utf8(out.stdout).unwrap()
+    };
+    assert!(run(false, &[]).contains("\x1b[38;2;"));
+    let plain = run(true, &[]);
+    assert!(
+        !plain.contains('\x1b') && plain.lines().count() == 4,
+        "{plain:?}"
+    );
+    // An explicit --format still wins.
+    assert!(run(true, &["--format", "ansi"]).contains("\x1b[38;2;"));
+}
+
+/// The PFM `raytty render --stage gi --samples n` writes, as linear floats.
+fn gi_pixels(samples: &str) -> Vec<f32> {
+    let out = raytty(&[
+        "render",
+        "--stage",
+        "gi",
+        "--pixels",
+        "24x24",
+        "--format",
+        "pfm",
+        "--samples",
+        samples,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let header = "PF\n24 24\n-1.0\n".len();
+    out.stdout[header..]
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect()
+}
+
+#[test]
+fn samples_make_the_gi_stage_converge() {
+    let reference = gi_pixels("256");
+    let error = |samples: &str| -> f32 {
+        let p = gi_pixels(samples);
+        p.iter()
+            .zip(&reference)
+            .map(|(a, b)| (a - b).abs())
+            .sum::<f32>()
+            / p.len() as f32
+    };
+    let (one, sixteen) = (error("1"), error("16"));
+    assert!(
+        sixteen < one / 2.0,
+        "16 samples ({sixteen}) are not much closer to 256 than 1 sample ({one})"
+    );
+    let out = raytty(&["render", "--samples", "0"]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn output_failures_are_one_line_with_status_1() {
+    for (args, needle) in [
+        (
+            &["render", "-o", "/nonexistent/box.png"][..],
+            "raytty: cannot create /nonexistent/box.png: No such file or directory\n",
+        ),
+        (
+            &["render", "-o", "/dev/full"],
+            "raytty: cannot write to /dev/full: No space left on device\n",
+        ),
+    ] {
+        let out = raytty(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(err, needle, "{args:?}");
+    }
+}
+
+#[test]
+fn a_bench_file_error_says_its_cause_once() {
+    let cache = std::env::temp_dir().join(format!("raytty-cli-cache-{}", std::process::id()));
+    let out = Command::new(env!("CARGO_BIN_EXE_raytty"))
+        .args(["bench", "--quick", "--readme", "/nonexistent/README.md"])
+        .env("XDG_CACHE_HOME", &cache)
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&cache);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.ends_with("raytty: cannot read /nonexistent/README.md: No such file or directory\n"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bench_flags_that_would_be_ignored_or_fail_late_are_refused_first() {
+    for (args, needle) in [
+        (
+            &["bench", "--scene", "cornell", "--csv"][..],
+            "--csv belong to the accuracy bench",
+        ),
+        (
+            &[
+                "bench",
+                "--scene",
+                "cornell",
+                "--svg",
+                "p.svg",
+                "--max-spp",
+                "4",
+            ],
+            "--svg, --max-spp belong",
+        ),
+        (
+            &["bench", "--quick", "--svg", "/nonexistent/plot.svg"],
+            "--svg /nonexistent/plot.svg: the folder /nonexistent does not exist",
+        ),
+    ] {
+        let out = raytty(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(out.stdout.is_empty(), "{args:?} ran before refusing");
+    }
+    // --quick with --scene: the quick bench's tiny sizes, not 500×500.
+    let out = raytty(&["bench", "--scene", "cornell", "--quick"]);
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(
+        table.contains("| 40×40 |") && !table.contains("500×500"),
+        "{table}"
+    );
+}
+
+#[test]
+fn light_on_a_scene_without_lights_is_refused() {
+    let dir = std::env::temp_dir().join(format!("raytty-cli-nolight-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("dark.toml");
+    std::fs::write(
+        &file,
+        "[material.w]\ncolour = [0.5, 0.5, 0.5]\n[[object]]\nkind = \"box\"\nmaterial = \"w\"\nmin = [-1, -1, -1]\nmax = [1, 1, 1]\n",
+    )
+    .unwrap();
+    let scene = file.to_str().unwrap();
+    let lit = raytty(&["--scene", scene, "render", "--light", "0,0,0"]);
+    let plain = raytty(&["--scene", scene, "render", "--format", "ascii"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+    let err = String::from_utf8_lossy(&lit.stderr);
+    assert_eq!(lit.status.code(), Some(2), "{err}");
+    assert!(err.contains("this scene has none"), "{err}");
+    assert!(plain.status.success());
 }

@@ -4,8 +4,13 @@
 //! a scene that renders a finite frame, or fail with an error that has a line and column. No
 //! input may panic, and none is larger than [`MAX_INPUT`] bytes, so none can take long.
 //!
-//! `cargo test` runs the regression corpus in `tests/fuzz_corpus/` (inputs the fuzzer once
-//! found interesting) and a short run; the long run is ignored:
+//! Mutations cannot tell whether a file that loaded should have: generated scenes can. Each
+//! value is drawn from in-range values (the limits included) or, now and then, out-of-range
+//! ones, and the scene must load exactly when all of its values are in range.
+//!
+//! `cargo test` runs the regression corpus in `tests/fuzz_corpus/` (hostile inputs: files
+//! named `ok_*.toml` must load, every other `.toml` must be refused with a position) and a
+//! short run; the long run is ignored:
 //!
 //!     RAYTTY_FUZZ_ITERATIONS=200000 RAYTTY_FUZZ_SEED=1 cargo test --test fuzz_scenes -- --ignored
 
@@ -160,6 +165,8 @@ struct Tally {
     loaded: u64,
     errors: u64,
     slowest: Duration,
+    /// The input that took longest (to replay it: the same seed, this many iterations + 1).
+    slowest_input: String,
 }
 
 /// Loads `scene` (with `mesh` as the mesh file) and checks the outcome; panics on a finding.
@@ -197,7 +204,10 @@ fn check(scene: &str, mesh: &[u8], tally: &mut Tally) {
         }
     }
     tally.inputs += 1;
-    tally.slowest = tally.slowest.max(start.elapsed());
+    if start.elapsed() > tally.slowest {
+        tally.slowest = start.elapsed();
+        tally.slowest_input = scene.chars().take(4000).collect();
+    }
 }
 
 /// An error has a line and a column, a message, and no control characters.
@@ -207,8 +217,13 @@ fn positioned(e: &SceneFileError, input: &str) {
         "error without a position: {e}\ninput: {input:?}"
     );
     let shown = e.to_string();
-    assert!(!shown.chars().any(char::is_control), "{shown:?}");
+    // The message, then the line with a caret under the column: newlines, nothing else.
+    assert!(
+        !shown.chars().any(|c| c.is_control() && c != '\n'),
+        "{shown:?}"
+    );
     assert!(shown.starts_with(&format!("{}:{}:{}: ", e.file, e.line, e.column)));
+    assert!(shown.lines().count() <= 3, "{shown}");
 }
 
 fn run(iterations: u64, seed: u64) -> Tally {
@@ -246,13 +261,183 @@ fn regression_corpus() {
             n += 1;
             let source = String::from_utf8_lossy(&std::fs::read(&path).unwrap()).into_owned();
             let outcome = catch_unwind(|| scenefile::load(&path));
+            let must_load = path
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("ok_");
             match outcome.unwrap_or_else(|_| panic!("{} panics", path.display())) {
-                Ok(_) => {}
-                Err(e) => positioned(&e, &source),
+                Ok(_) => assert!(must_load, "{} loads", path.display()),
+                Err(e) => {
+                    assert!(!must_load, "{}: {e}", path.display());
+                    positioned(&e, &source);
+                }
             }
         }
     }
     assert!(n >= 5, "the corpus has {n} files");
+}
+
+/// A value for a generated scene: its TOML text and whether it is within the key's range.
+type Pick = (String, bool);
+
+/// One of `valid` or `invalid` (one time in 50: a scene has about 35 values, so about half of
+/// the scenes have a bad one), as TOML text.
+fn pick(rng: &mut Rng, valid: &[&str], invalid: &[&str]) -> Pick {
+    let bad = rng.next_u64().is_multiple_of(50) && !invalid.is_empty();
+    let pool = if bad { invalid } else { valid };
+    (
+        pool[(rng.next_u64() % pool.len() as u64) as usize].to_string(),
+        !bad,
+    )
+}
+
+/// A scene whose every value is drawn from a pool of in-range values (the limits themselves
+/// included) or, now and then, of out-of-range ones, with whether it should load.
+fn generated(rng: &mut Rng) -> (String, bool) {
+    let mut ok = true;
+    let mut text = String::new();
+    let mut put = |key: &str, (v, fine): Pick, text: &mut String| {
+        ok &= fine;
+        *text += &format!("{key} = {v}\n");
+    };
+    const COORD: [&str; 5] = ["0", "-1.5", "1e6", "-1e6", "0.25"];
+    const BAD_COORD: [&str; 4] = ["1000001", "nan", "-inf", "1e300"];
+    let triple = |rng: &mut Rng, valid: &[&str], invalid: &[&str]| -> Pick {
+        let (mut ok, mut parts) = (true, Vec::new());
+        for _ in 0..3 {
+            let (v, fine) = pick(rng, valid, invalid);
+            ok &= fine;
+            parts.push(v);
+        }
+        (format!("[{}]", parts.join(", ")), ok)
+    };
+    text += "[camera]\n";
+    put("position", triple(rng, &COORD, &BAD_COORD), &mut text);
+    put(
+        "yaw",
+        pick(rng, &["0", "360", "-360", "12.5"], &["360.5", "nan", "1e9"]),
+        &mut text,
+    );
+    put(
+        "pitch",
+        pick(rng, &["0", "90", "-90", "-30"], &["90.01", "-91", "inf"]),
+        &mut text,
+    );
+    for _ in 0..1 + rng.next_u64() % 3 {
+        text += "[[light]]\n";
+        put("position", triple(rng, &COORD, &BAD_COORD), &mut text);
+        let power = ["0", "14", "1e12", "[1, 0, 3]", "[0, 0, 1e12]"];
+        put(
+            "power",
+            pick(
+                rng,
+                &power,
+                &["-1", "1.1e12", "nan", "[1, -0.5, 1]", "[1, 2]"],
+            ),
+            &mut text,
+        );
+    }
+    text += "[material.m]\n";
+    put(
+        "colour",
+        triple(rng, &["0", "1", "0.75"], &["1.01", "-0.1", "nan"]),
+        &mut text,
+    );
+    put(
+        "mirror",
+        pick(rng, &["0", "1", "0.5"], &["2", "-0.01", "nan"]),
+        &mut text,
+    );
+    text += "[[object]]\nkind = \"box\"\nmaterial = \"m\"\ncentre = [0, 0, 0]\n";
+    put(
+        "size",
+        triple(rng, &["1", "0.5", "2"], &["0", "-1", "nan"]),
+        &mut text,
+    );
+    put(
+        "scale",
+        pick(
+            rng,
+            &["1e-3", "1e5", "1", "[1, 2, 3]"],
+            &["0", "-1", "1e7", "[1, 0, 1]"],
+        ),
+        &mut text,
+    );
+    put(
+        "rotate_y",
+        pick(rng, &["0", "-360", "45", "360"], &["361", "nan"]),
+        &mut text,
+    );
+    put(
+        "translate",
+        triple(rng, &["0", "-10", "3.5"], &["nan", "1e7"]),
+        &mut text,
+    );
+    text += "[effects]\n";
+    put(
+        "shadows",
+        pick(rng, &["true", "false"], &["1", "\"yes\""]),
+        &mut text,
+    );
+    let indirect = [
+        "\"none\"",
+        "0",
+        "0.5",
+        "100",
+        "{ bounces = 0 }",
+        "{ bounces = 16 }",
+    ];
+    put(
+        "indirect",
+        pick(
+            rng,
+            &indirect,
+            &[
+                "101",
+                "-1",
+                "\"full\"",
+                "{ bounces = 17 }",
+                "{ bounces = -1 }",
+            ],
+        ),
+        &mut text,
+    );
+    put(
+        "samples",
+        pick(rng, &["1", "4", "1024"], &["0", "1025", "-3", "1.5"]),
+        &mut text,
+    );
+    (text, ok)
+}
+
+/// Loads `n` generated scenes from `seed`, checking each against the generator's verdict;
+/// returns how many loaded and how many were refused.
+fn run_generated(n: u64, seed: u64) -> (u64, u64) {
+    let mut rng = Rng::seeded(seed);
+    let (mut loaded, mut refused) = (0, 0);
+    for _ in 0..n {
+        let (text, ok) = generated(&mut rng);
+        match scenefile::parse(&text, "gen.toml", "gen", &scenefile::no_meshes) {
+            Ok(_) if ok => loaded += 1,
+            Err(e) if !ok => {
+                positioned(&e, &text);
+                refused += 1;
+            }
+            Ok(_) => panic!("loaded, but a value is out of range:\n{text}"),
+            Err(e) => panic!("refused, but every value is in range: {e}\n{text}"),
+        }
+    }
+    (loaded, refused)
+}
+
+#[test]
+fn generated_scenes_load_exactly_when_every_value_is_in_range() {
+    let (loaded, refused) = run_generated(400, 11);
+    assert!(
+        loaded > 100 && refused > 100,
+        "{loaded} loaded, {refused} refused"
+    );
 }
 
 /// A short run in every `cargo test`: a few hundred inputs, well under a second.
@@ -286,5 +471,13 @@ fn long_run() {
         t.loaded,
         t.errors,
         t.slowest
+    );
+    eprintln!("the slowest input:\n{}", t.slowest_input);
+    let start = Instant::now();
+    let (loaded, refused) = run_generated(n / 10, seed);
+    eprintln!(
+        "generated: {} scenes from seed {seed} in {:.1?}: {loaded} loaded and {refused} refused, each as its values said",
+        n / 10,
+        start.elapsed()
     );
 }

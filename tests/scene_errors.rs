@@ -169,6 +169,24 @@ fn degenerate_triangles_are_errors_in_scene_files_and_meshes() {
         &format!("{BASE}[[object]]\nkind = \"obj\"\nmaterial = \"white\"\npath = \"flat.obj\"\n"),
     );
     says(&err, &d.join("flat.obj"), 5, 1, &["degenerate triangle"]);
+    // A fine box made degenerate by its transform: a micrometre box ten units out, where f32
+    // steps are a micrometre apart. The message blames the transform, not the box.
+    let err = fails(
+        &d,
+        &format!(
+            "{BASE}[[object]]\nkind = \"box\"\nmaterial = \"white\"\ncentre = [0, 0, 0]\nsize = [1, 0.5, 1]\nscale = 1e-6\ntranslate = [-10, -10, 0]\n"
+        ),
+    );
+    says(
+        &err,
+        &d.join("scene.toml"),
+        7,
+        1,
+        &[
+            "the transform makes a triangle degenerate",
+            "nearer the origin",
+        ],
+    );
 }
 
 #[test]

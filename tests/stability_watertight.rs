@@ -8,7 +8,7 @@ mod common;
 
 use common::{Rng, unit};
 use glam::Vec3;
-use raytty::{Camera, Effects, Material, Ray, Scene, SceneBuilder, cornell_box};
+use raytty::{Camera, Effects, Material, Ray, Scene, SceneBuilder, cornell_box, procedural};
 
 /// Random rays per mesh in the random-ray test (the issue asks for 100 000 on the sphere).
 const RANDOM_RAYS: u32 = 100_000;
@@ -39,45 +39,10 @@ fn scene_of(triangles: Vec<[Vec3; 3]>) -> Scene {
 /// An icosahedron subdivided `levels` times, vertices shared between faces, each vertex at a
 /// jittered radius from `centre`. Returns the shared vertex list and the faces.
 fn icosphere(levels: u32, centre: Vec3, seed: u64) -> (Vec<Vec3>, Vec<[usize; 3]>) {
-    let g = (1.0 + 5f32.sqrt()) / 2.0;
-    let mut verts: Vec<Vec3> = [
-        (-1.0, g, 0.0),
-        (1.0, g, 0.0),
-        (-1.0, -g, 0.0),
-        (1.0, -g, 0.0),
-        (0.0, -1.0, g),
-        (0.0, 1.0, g),
-        (0.0, -1.0, -g),
-        (0.0, 1.0, -g),
-        (g, 0.0, -1.0),
-        (g, 0.0, 1.0),
-        (-g, 0.0, -1.0),
-        (-g, 0.0, 1.0),
-    ]
-    .map(|(x, y, z)| Vec3::new(x, y, z).normalize())
-    .to_vec();
-    let mut faces: Vec<[usize; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
+    let mut verts: Vec<Vec3> = procedural::icosahedron_vertices()
+        .map(|v| v.as_vec3().normalize())
+        .to_vec();
+    let mut faces = procedural::ICOSAHEDRON_FACES.to_vec();
     for _ in 0..levels {
         let mut mid = std::collections::HashMap::new();
         let mut midpoint = |a: usize, b: usize, verts: &mut Vec<Vec3>| {

@@ -37,6 +37,17 @@ impl Session {
 
     /// [`Session::start`] with more arguments for raytty.
     fn start_with(cols: u16, rows: u16, first_frame_only: bool, args: &[&str]) -> Session {
+        Session::start_term(cols, rows, first_frame_only, args, "xterm-256color")
+    }
+
+    /// [`Session::start_with`] with `TERM` set to `term`.
+    fn start_term(
+        cols: u16,
+        rows: u16,
+        first_frame_only: bool,
+        args: &[&str],
+        term: &str,
+    ) -> Session {
         let pair = native_pty_system()
             .openpty(PtySize {
                 rows,
@@ -48,7 +59,7 @@ impl Session {
         let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_raytty"));
         cmd.args(["--color", "truecolor"]);
         cmd.args(args);
-        cmd.env("TERM", "xterm-256color");
+        cmd.env("TERM", term);
         cmd.env_remove("NO_COLOR");
         let child = pair.slave.spawn_command(cmd).expect("spawn raytty");
         drop(pair.slave);
@@ -334,4 +345,48 @@ fn the_app_shows_the_scene_given_with_scene() {
     assert!(!shows(s.screen.screen(), &cornell));
     s.send(b"\x03");
     assert!(s.finish().success());
+}
+
+#[test]
+fn a_bad_scene_is_refused_before_the_terminal_is_touched() {
+    let mut s = Session::start_with(100, 10, false, &["--scene", "no-such-scene"]);
+    let status = s.finish();
+    assert_eq!(status.exit_code(), 2);
+    let screen = s.screen.screen();
+    assert!(!screen.alternate_screen() && !screen.hide_cursor());
+    let text = screen.contents();
+    assert!(
+        text.contains("no-such-scene") && text.contains("cornell, mirror, lights, sphere"),
+        "{text}"
+    );
+}
+
+#[test]
+fn the_loading_note_is_erased_when_the_app_ends_and_before_an_error() {
+    let mut s = Session::start(60, 10, false);
+    s.wait_for_status(&["indirect"]);
+    s.send(b"\x1b");
+    assert!(s.finish().success());
+    let shown = s.screen.screen().contents();
+    assert!(!shown.contains("loading"), "{shown}");
+    let mut s = Session::start_with(100, 10, false, &["--scene", "no-such-scene"]);
+    assert_eq!(s.finish().exit_code(), 2);
+    let shown = s.screen.screen().contents();
+    assert!(
+        shown.starts_with("raytty: --scene no-such-scene"),
+        "{shown}"
+    );
+}
+
+#[test]
+fn a_dumb_terminal_gets_one_frame_not_the_app() {
+    let mut s = Session::start_term(100, 40, false, &[], "dumb");
+    let status = s.finish();
+    assert!(status.success(), "{status:?}");
+    let shown = s.screen.screen().contents();
+    // The app would have left the alternate screen and with it the frame; a printed frame
+    // stays on the main screen, under the note that says why.
+    assert!(shown.contains("TERM=dumb"), "{shown}");
+    assert!(shown.contains('▀'), "{shown}");
+    assert!(!shown.contains("H:help"), "{shown}");
 }

@@ -50,7 +50,8 @@ impl PrimRef {
     /// overflow).
     #[inline]
     fn centroid(&self, axis: usize) -> f32 {
-        self.min[axis] * 0.5 + self.max[axis] * 0.5
+        let (min, max): (&[f32; 3], &[f32; 3]) = (self.min.as_ref(), self.max.as_ref());
+        min[axis] * 0.5 + max[axis] * 0.5
     }
 }
 
@@ -79,10 +80,16 @@ impl Bounds {
         self
     }
 
-    /// Surface area in `f64` (f32 extents of huge boxes would overflow when multiplied).
+    /// Surface area: in `f32`, or in `f64` when that overflows (huge boxes).
+    #[inline]
     fn area(&self) -> f64 {
         if !(self.min.x <= self.max.x) {
             return 0.0;
+        }
+        let d = self.max - self.min;
+        let a = 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
+        if a.is_finite() {
+            return f64::from(a);
         }
         let d = self.max.as_dvec3() - self.min.as_dvec3();
         2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
@@ -148,10 +155,20 @@ impl Binning {
         (extent > 0.0 && scale.is_finite() && scale > 0.0).then_some(Binning { axis, lo, scale })
     }
 
+    /// The bin of a triangle whose centroid is `c` along this axis.
     #[inline]
-    fn bin(&self, c: Vec3) -> usize {
-        (((c[self.axis] - self.lo) * self.scale) as usize).min(SAH_BINS - 1)
+    fn bin(&self, c: f32) -> usize {
+        bin_index((c - self.lo) * self.scale)
     }
+}
+
+/// Bin of a scaled centroid distance, clamped to the bins (NaN to bin 0). The same operations as
+/// [`bin_all`]'s three-axes-at-once form, so both passes agree on every triangle.
+#[inline]
+fn bin_index(k: f32) -> usize {
+    let k = if k > 0.0 { k } else { 0.0 };
+    let last = (SAH_BINS - 1) as f32;
+    (if k < last { k } else { last }) as i32 as usize
 }
 
 /// One axis's bins: boxes and counts.
@@ -191,17 +208,23 @@ fn union_bins(mut a: Bins, b: Bins) -> Bins {
 }
 
 fn bin_all(refs: &[PrimRef], binnings: &[Option<Binning>; 3]) -> Bins {
+    // All three axes at once: an axis without bins gets scale 0 (every triangle in bin 0) and
+    // its bins are never read.
+    let lo = Vec3::from_array(binnings.map(|b| b.map_or(0.0, |b| b.lo)));
+    let scale = Vec3::from_array(binnings.map(|b| b.map_or(0.0, |b| b.scale)));
+    let last = Vec3::splat((SAH_BINS - 1) as f32);
     let fold = |refs: &[PrimRef]| {
         let mut bins = [AxisBins::EMPTY; 3];
         for r in refs {
             let c = r.min * 0.5 + r.max * 0.5;
-            for (bins, b) in bins.iter_mut().zip(binnings) {
-                if let Some(b) = b {
-                    let k = b.bin(c);
-                    bins.min[k] = bins.min[k].min(r.min);
-                    bins.max[k] = bins.max[k].max(r.max);
-                    bins.count[k] += 1;
-                }
+            // Vec3::max/min are `if a > b { a } else { b }` per lane, as in `bin_index`.
+            let k = ((c - lo) * scale).max(Vec3::ZERO).min(last);
+            for (bins, k) in bins.iter_mut().zip(k.to_array()) {
+                // In [0, 15]: the 32-bit conversion is one instruction, the 64-bit one several.
+                let k = k as i32 as usize;
+                bins.min[k] = bins.min[k].min(r.min);
+                bins.max[k] = bins.max[k].max(r.max);
+                bins.count[k] += 1;
             }
         }
         bins
@@ -223,6 +246,9 @@ enum Split {
     Binned(Binning, usize),
     /// Sort by centroid along the axis (ties by scene index) and cut at this many.
     Sorted(usize, usize),
+    /// Put the entries in this order (a small node's, sorted along the chosen axis) and cut at
+    /// this many.
+    Ordered([u8; SMALL_NODE], usize),
     /// All centroids coincide: cut the list in two as it is.
     Halve,
 }
@@ -396,20 +422,20 @@ fn split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32) -> Option<usize> {
     let mid = match choose_split(refs, nb, depth) {
         Split::Leaf => return None,
         Split::Binned(binning, bin) => {
-            partition(refs, |r| binning.bin(r.min * 0.5 + r.max * 0.5) < bin)
+            partition(refs, |r| binning.bin(r.centroid(binning.axis)) < bin)
         }
         Split::Sorted(axis, mid) => {
-            let key = |r: &PrimRef| (r.centroid(axis), r.id);
-            if n <= SMALL_NODE {
-                refs.sort_unstable_by(|a, b| {
-                    let (a, b) = (key(a), key(b));
-                    a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
-                });
-            } else {
-                refs.select_nth_unstable_by(mid, |a, b| {
-                    let (a, b) = (key(a), key(b));
-                    a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
-                });
+            refs.select_nth_unstable_by(mid, |a, b| {
+                a.centroid(axis)
+                    .total_cmp(&b.centroid(axis))
+                    .then(a.id.cmp(&b.id))
+            });
+            mid
+        }
+        Split::Ordered(order, mid) => {
+            let old: [PrimRef; SMALL_NODE] = std::array::from_fn(|i| refs[i.min(n - 1)]);
+            for (r, &o) in refs.iter_mut().zip(&order[..n]) {
+                *r = old[o as usize];
             }
             mid
         }
@@ -420,7 +446,7 @@ fn split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32) -> Option<usize> {
 }
 
 /// Picks how to split a node of `refs.len()` triangles with bounds `nb`.
-fn choose_split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32) -> Split {
+fn choose_split(refs: &[PrimRef], nb: &NodeBounds, depth: u32) -> Split {
     let n = refs.len();
     if n == 1 {
         return Split::Leaf;
@@ -507,40 +533,58 @@ fn binned_sah(refs: &[PrimRef], c: &Bounds) -> (Option<f64>, Option<Split>) {
     }
 }
 
-/// The exact SAH for a small node: every cut between centroids sorted along each axis.
-fn small_sah(refs: &mut [PrimRef], c: &Bounds) -> (Option<f64>, Option<Split>) {
+/// The exact SAH for a small node: every cut between centroids sorted along each axis (ties
+/// by scene index).
+#[allow(clippy::needless_range_loop)] // `axis` picks a coordinate of several arrays' entries
+fn small_sah(refs: &[PrimRef], c: &Bounds) -> (Option<f64>, Option<Split>) {
     let n = refs.len();
-    let mut best: Option<(f64, usize, usize)> = None;
+    debug_assert!(n <= SMALL_NODE);
+    let centroids: [[f32; 3]; SMALL_NODE] = std::array::from_fn(|i| {
+        refs.get(i)
+            .map_or([0.0; 3], |r| (r.min * 0.5 + r.max * 0.5).to_array())
+    });
+    let mut best: Option<(f64, [u8; SMALL_NODE], usize)> = None;
     let mut right_cost = [0f64; SMALL_NODE];
     for axis in 0..3 {
         if !(c.max[axis] > c.min[axis]) {
             continue;
         }
-        refs.sort_unstable_by(|a, b| {
-            a.centroid(axis)
-                .total_cmp(&b.centroid(axis))
-                .then(a.id.cmp(&b.id))
-        });
+        // Sort by (centroid, scene index) as one integer key: the centroid's bits mapped to
+        // an unsigned integer in `total_cmp` order, then the index.
+        let mut keys = [(u64::MAX, 0u8); SMALL_NODE];
+        for (i, key) in keys[..n].iter_mut().enumerate() {
+            let bits = centroids[i][axis].to_bits();
+            let ordered = if bits >> 31 == 1 {
+                !bits
+            } else {
+                bits | 1 << 31
+            };
+            *key = ((u64::from(ordered) << 32) | u64::from(refs[i].id), i as u8);
+        }
+        keys[..n].sort_unstable_by_key(|k| k.0);
+        let order: [u8; SMALL_NODE] = keys.map(|k| k.1);
         let mut acc = Bounds::EMPTY;
         for k in (1..n).rev() {
-            acc.grow(refs[k].min, refs[k].max);
+            let r = &refs[order[k] as usize];
+            acc.grow(r.min, r.max);
             right_cost[k] = acc.area() * (n - k) as f64;
         }
         let mut acc = Bounds::EMPTY;
         for k in 1..n {
-            acc.grow(refs[k - 1].min, refs[k - 1].max);
-            // Cut only between distinct centroids, so the halves' centroid boxes shrink.
-            if refs[k - 1].centroid(axis) == refs[k].centroid(axis) {
+            let (prev, next) = (order[k - 1] as usize, order[k] as usize);
+            acc.grow(refs[prev].min, refs[prev].max);
+            // Cut only between distinct centroids, so each half's centroid box shrinks.
+            if centroids[prev][axis] == centroids[next][axis] {
                 continue;
             }
             let cost = acc.area() * k as f64 + right_cost[k];
             if best.is_none_or(|(c, _, _)| cost < c) {
-                best = Some((cost, axis, k));
+                best = Some((cost, order, k));
             }
         }
     }
     match best {
-        Some((cost, axis, k)) => (Some(cost), Some(Split::Sorted(axis, k))),
+        Some((cost, order, k)) => (Some(cost), Some(Split::Ordered(order, k))),
         None => (None, None),
     }
 }

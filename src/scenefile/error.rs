@@ -16,17 +16,47 @@ pub struct SceneFileError {
     pub column: usize,
     /// What was wrong and what would be right (control characters removed).
     pub message: String,
+    /// The line in question, control characters removed, cut to about [`EXCERPT_CHARS`]
+    /// characters around the column; empty when there is none to show.
+    pub excerpt: String,
+    /// The column within `excerpt` (1-based), for the caret under it.
+    pub excerpt_column: usize,
 }
+
+/// Most characters of a line shown under an error.
+pub const EXCERPT_CHARS: usize = 100;
 
 impl SceneFileError {
     /// An error at byte `offset` of `source` (clamped to its length).
     pub fn at(file: &str, source: &str, offset: usize, message: impl Into<String>) -> Self {
         let (line, column) = line_column(source, offset);
+        SceneFileError::at_line(file, source, line, column, message)
+    }
+
+    /// An error at a 1-based `line` and `column` (in characters) of `text`.
+    pub fn at_line(
+        file: &str,
+        text: &str,
+        line: usize,
+        column: usize,
+        message: impl Into<String>,
+    ) -> Self {
+        let whole = text.split('\n').nth(line.saturating_sub(1)).unwrap_or("");
+        // Tabs become spaces so that the caret stays under the column.
+        let chars: Vec<char> = whole
+            .chars()
+            .map(|c| if c == '\t' { ' ' } else { c })
+            .collect();
+        let start = column.saturating_sub(EXCERPT_CHARS / 2).min(chars.len());
+        let end = (start + EXCERPT_CHARS).min(chars.len());
+        let shown: String = chars[start..end].iter().collect();
         SceneFileError {
             file: printable(file),
             line,
             column,
             message: printable(&message.into()),
+            excerpt: printable(shown.trim_end()),
+            excerpt_column: column - start,
         }
     }
 
@@ -37,6 +67,8 @@ impl SceneFileError {
             line: 0,
             column: 0,
             message: printable(&message.into()),
+            excerpt: String::new(),
+            excerpt_column: 0,
         }
     }
 }
@@ -44,14 +76,26 @@ impl SceneFileError {
 impl fmt::Display for SceneFileError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         if self.line == 0 {
-            write!(f, "{}: {}", self.file, self.message)
-        } else {
+            return write!(f, "{}: {}", self.file, self.message);
+        }
+        write!(
+            f,
+            "{}:{}:{}: {}",
+            self.file, self.line, self.column, self.message
+        )?;
+        if !self.excerpt.is_empty() {
+            let gutter = self.line.to_string().len();
             write!(
                 f,
-                "{}:{}:{}: {}",
-                self.file, self.line, self.column, self.message
-            )
+                "\n {} | {}\n {:gutter$} | {:>col$}",
+                self.line,
+                self.excerpt,
+                "",
+                "^",
+                col = self.excerpt_column.max(1)
+            )?;
         }
+        Ok(())
     }
 }
 
@@ -134,6 +178,22 @@ mod tests {
         let second = s.rfind('=').unwrap();
         assert_eq!(line_column(s, second), (2, 4));
         assert_eq!(line_column(s, 10_000), (3, 1));
+    }
+
+    #[test]
+    fn the_line_is_shown_with_a_caret_under_the_column() {
+        let e = SceneFileError::at("f.toml", "a = 1\n\tcolr = 2\n", 7, "unknown key");
+        assert_eq!(
+            e.to_string(),
+            "f.toml:2:2: unknown key\n 2 |  colr = 2\n   |  ^"
+        );
+        // A long line is cut around the column, and the caret follows.
+        let long = format!("x = [{}9]", "1, ".repeat(200));
+        let e = SceneFileError::at("f.toml", &long, long.len() - 2, "here");
+        let caret = e.to_string().lines().last().unwrap().len();
+        let shown = e.to_string().lines().nth(1).unwrap().to_string();
+        assert_eq!(shown.as_bytes()[caret - 1], b'9', "{e}");
+        assert!(e.excerpt.chars().count() <= EXCERPT_CHARS);
     }
 
     #[test]

@@ -28,7 +28,7 @@ pub struct SceneSpec {
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 pub struct CameraSpec {
-    pub position: Option<Spanned<[f64; 3]>>,
+    pub position: Option<Spanned<Three<f64>>>,
     pub yaw: Option<Spanned<f64>>,
     pub pitch: Option<Spanned<f64>>,
 }
@@ -37,7 +37,7 @@ pub struct CameraSpec {
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 pub struct LightSpec {
-    pub position: Spanned<[f64; 3]>,
+    pub position: Spanned<Three<f64>>,
     pub power: Spanned<NumberOrTriple>,
 }
 
@@ -45,7 +45,7 @@ pub struct LightSpec {
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
-    pub colour: Spanned<[f64; 3]>,
+    pub colour: Spanned<Three<f64>>,
     pub mirror: Option<Spanned<f64>>,
 }
 
@@ -56,20 +56,20 @@ pub struct ObjectSpec {
     pub kind: Spanned<String>,
     pub material: Spanned<String>,
     pub triangles: Option<Spanned<Vec<Spanned<TriangleSpec>>>>,
-    pub min: Option<Spanned<[f64; 3]>>,
-    pub max: Option<Spanned<[f64; 3]>>,
-    pub centre: Option<Spanned<[f64; 3]>>,
-    pub size: Option<Spanned<[f64; 3]>>,
+    pub min: Option<Spanned<Three<f64>>>,
+    pub max: Option<Spanned<Three<f64>>>,
+    pub centre: Option<Spanned<Three<f64>>>,
+    pub size: Option<Spanned<Three<f64>>>,
     pub path: Option<Spanned<String>>,
     pub subdivisions: Option<Spanned<i64>>,
     pub amplitude: Option<Spanned<f64>>,
-    pub translate: Option<Spanned<[f64; 3]>>,
+    pub translate: Option<Spanned<Three<f64>>>,
     pub rotate_y: Option<Spanned<f64>>,
     pub scale: Option<Spanned<NumberOrTriple>>,
 }
 
 /// A triangle's three vertices.
-pub type TriangleSpec = [[f64; 3]; 3];
+pub type TriangleSpec = Three<Three<f64>>;
 
 /// `[effects]`.
 #[derive(Deserialize, Debug)]
@@ -78,6 +78,38 @@ pub struct EffectsSpec {
     pub shadows: Option<bool>,
     pub indirect: Option<Spanned<IndirectSpec>>,
     pub samples: Option<Spanned<i64>>,
+}
+
+/// Exactly three values: `[a, b, c]` (serde's arrays would take a fourth in silence).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Three<T>(pub [T; 3]);
+
+impl<'de, T: Deserialize<'de> + Copy + Default> Deserialize<'de> for Three<T> {
+    fn deserialize<D: de::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de> + Copy + Default> Visitor<'de> for V<T> {
+            type Value = Three<T>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("three values [a, b, c]")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+                let mut out = [T::default(); 3];
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = seq
+                        .next_element()?
+                        .ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                }
+                if seq.next_element::<de::IgnoredAny>()?.is_some() {
+                    return Err(de::Error::invalid_length(
+                        4,
+                        &"exactly three values [a, b, c]",
+                    ));
+                }
+                Ok(Three(out))
+            }
+        }
+        d.deserialize_seq(V(std::marker::PhantomData))
+    }
 }
 
 /// A number (the same for x, y, z or r, g, b) or a triple.
@@ -109,7 +141,10 @@ impl<'de> Deserialize<'de> for NumberOrTriple {
                         .ok_or_else(|| de::Error::invalid_length(i, &self))?;
                 }
                 if seq.next_element::<de::IgnoredAny>()?.is_some() {
-                    return Err(de::Error::invalid_length(4, &self));
+                    return Err(de::Error::invalid_length(
+                        4,
+                        &"exactly three numbers [a, b, c]",
+                    ));
                 }
                 Ok(NumberOrTriple(out))
             }

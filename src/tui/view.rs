@@ -18,6 +18,18 @@ pub const MIN_ROWS: u16 = 3;
 /// each); the app is then idle.
 pub const GI_MAX_PASSES: u32 = 256;
 
+/// The too-small message, line by line, each from its longest wording to its shortest: the
+/// longest that fits the terminal's width is shown.
+const TOO_SMALL: [&[&str]; 2] = [
+    &[
+        "raytty: terminal too small",
+        "terminal too small",
+        "too small",
+        "small",
+    ],
+    &["Esc quits", "Esc:quit", "Esc"],
+];
+
 /// DEC private mode 2026: the terminal shows the frame only when it is complete.
 const SYNC_BEGIN: &[u8] = b"\x1b[?2026h";
 const SYNC_END: &[u8] = b"\x1b[?2026l";
@@ -129,11 +141,8 @@ impl Screen {
         let (cols, rows) = (app.size.0 as usize, app.size.1 as usize);
         let grid = if image_size(app.size) != Some((self.image.width, self.image.height)) {
             let mut g = blank(cols, rows, app.color);
-            for (i, line) in ["raytty: terminal too small", "Esc quits"]
-                .iter()
-                .enumerate()
-            {
-                put_text(&mut g, 0, i, line, app.color);
+            for (i, variants) in TOO_SMALL.iter().enumerate() {
+                put_text(&mut g, 0, i, longest_that_fits(variants, cols), app.color);
             }
             g
         } else {
@@ -163,8 +172,9 @@ impl Screen {
     }
 
     /// The status line: scene (first, so a narrow terminal still shows it), stage, camera,
-    /// light, costs of the last frame, colour mode. The scene's name comes from a file: its
-    /// control characters are removed.
+    /// light, costs of the last frame, colour mode, the help key. Fields that do not fit the
+    /// terminal's width are left out, least useful first (see [`fit_status`]). The scene's
+    /// name comes from a file: its control characters are removed.
     fn status(&self, app: &App) -> String {
         let key = Stage::ALL.iter().position(|&s| s == app.stage).unwrap_or(0) + 1;
         let spp = if app.stage == Stage::Gi {
@@ -173,18 +183,63 @@ impl Screen {
             String::new()
         };
         let light = app.light().map_or_else(|| "none".into(), xyz);
-        format!(
-            " {}  {key}:{}{spp}  cam {} {}°  light {light}  render {:.1}ms encode {:.1}ms {}B  {}  H:help",
-            printable(&app.scene.name),
-            app.stage.name(),
-            xyz(app.camera.position),
-            fixed(app.camera.yaw.to_degrees(), 0),
-            ms(self.stats.render.elapsed),
-            ms(self.stats.encode),
-            self.stats.bytes,
-            app.color.name(),
-        )
+        // (text, rank): rank 0 is always shown, then the lowest ranks first while they fit.
+        let fields = [
+            (printable(&app.scene.name), 0),
+            (format!("{key}:{}{spp}", app.stage.name()), 0),
+            (
+                format!(
+                    "cam {} {}°",
+                    xyz(app.camera.position),
+                    fixed(app.camera.yaw.to_degrees(), 0)
+                ),
+                4,
+            ),
+            (format!("light {light}"), 5),
+            (format!("render {:.1}ms", ms(self.stats.render.elapsed)), 3),
+            (format!("encode {:.1}ms", ms(self.stats.encode)), 8),
+            (format!("{}B", self.stats.bytes), 7),
+            (app.color.name().to_string(), 6),
+            ("H:help".to_string(), 2),
+        ];
+        fit_status(&fields, app.size.0 as usize)
     }
+}
+
+/// Joins `fields` (text, rank) into a status line of at most `width` characters where
+/// possible: fields are taken by rank, lowest first, each one only if the line still fits
+/// with it; the fields kept stay in their order. Rank-0 fields are always kept (the line is
+/// clipped when drawn instead).
+fn fit_status(fields: &[(String, u8)], width: usize) -> String {
+    let line = |keep: &[bool]| -> String {
+        let kept: Vec<&str> = fields
+            .iter()
+            .zip(keep)
+            .filter(|(_, k)| **k)
+            .map(|((t, _), _)| t.as_str())
+            .collect();
+        format!(" {}", kept.join("  "))
+    };
+    let mut keep: Vec<bool> = fields.iter().map(|(_, r)| *r == 0).collect();
+    let mut by_rank: Vec<usize> = (0..fields.len()).filter(|&i| fields[i].1 > 0).collect();
+    by_rank.sort_by_key(|&i| fields[i].1);
+    for i in by_rank {
+        keep[i] = true;
+        if line(&keep).chars().count() > width {
+            keep[i] = false;
+        }
+    }
+    line(&keep)
+}
+
+/// The first of `variants` (longest first) that fits in `width` characters, else the last.
+fn longest_that_fits<'a>(variants: &[&'a str], width: usize) -> &'a str {
+    variants
+        .iter()
+        .find(|v| v.chars().count() <= width)
+        .or(variants.last())
+        .copied()
+        .unwrap_or("")
 }
 
 /// `v` with `decimals` places, and no "-0" for a value that rounds to zero.
@@ -267,6 +322,81 @@ mod tests {
         assert!(s.needs_render(&a));
         s.render(&a);
         assert_eq!(s.passes(), 1);
+    }
+
+    #[test]
+    fn the_status_line_fits_the_width_keeping_the_most_useful_fields() {
+        let mut s = Screen::new();
+        let wide = app(200, 10);
+        s.render(&wide);
+        s.draw(&wide);
+        let full = s.status(&wide);
+        for part in [
+            "cornell",
+            "5:indirect",
+            "cam ",
+            "light ",
+            "render ",
+            "encode ",
+            "B  ",
+        ] {
+            assert!(full.contains(part), "{part:?} missing from {full:?}");
+        }
+        assert!(full.ends_with("truecolor  H:help"), "{full:?}");
+        let at80 = s.status(&app(80, 24));
+        assert!(at80.chars().count() <= 80, "{at80:?}");
+        for part in [
+            "cornell",
+            "5:indirect",
+            "render ",
+            "H:help",
+            "cam 0.00,0.00,-3.00 0°",
+            "truecolor",
+        ] {
+            assert!(
+                at80.contains(part),
+                "{part:?} missing at 80 columns: {at80:?}"
+            );
+        }
+        assert!(!at80.contains("encode"), "{at80:?}");
+        let narrow = s.status(&app(24, 10));
+        assert!(narrow.starts_with(" cornell  5:indirect"), "{narrow:?}");
+        assert!(narrow.chars().count() <= 24, "{narrow:?}");
+    }
+
+    #[test]
+    fn fit_status_takes_fields_by_rank_while_they_fit_in_their_order() {
+        let f = |t: &str, r| (t.to_string(), r);
+        let fields = [f("a", 0), f("bbbb", 2), f("cc", 1), f("dddd", 3)];
+        assert_eq!(fit_status(&fields, 100), " a  bbbb  cc  dddd");
+        assert_eq!(fit_status(&fields, 12), " a  bbbb  cc");
+        assert_eq!(fit_status(&fields, 8), " a  cc");
+        assert_eq!(fit_status(&fields, 1), " a");
+        // A field too long to fit does not stop a shorter, later-ranked one.
+        let fields = [f("a", 0), f("bbbbbbbb", 1), f("c", 2)];
+        assert_eq!(fit_status(&fields, 8), " a  c");
+    }
+
+    #[test]
+    fn the_too_small_message_is_worded_to_fit() {
+        let text = |c: u16, r: u16| {
+            let a = app(c, r);
+            let mut s = Screen::new();
+            s.draw(&a);
+            let g = s.shown.as_ref().unwrap();
+            (0..g.rows)
+                .map(|row| {
+                    let line: String = g.cells[row * g.cols..(row + 1) * g.cols]
+                        .iter()
+                        .map(|c| c.ch)
+                        .collect();
+                    line.trim_end().to_string()
+                })
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(text(8, 3), ["small", "Esc:quit", ""]);
+        assert_eq!(text(9, 3), ["too small", "Esc quits", ""]);
+        assert_eq!(text(40, 2), ["raytty: terminal too small", "Esc quits"]);
     }
 
     #[test]

@@ -1,0 +1,154 @@
+//! Positions and value checks: a byte offset in the scene file becomes a [`SceneFileError`]
+//! with a line and column, and serde's messages become ones a TOML user can act on.
+
+use glam::Vec3;
+use toml::Spanned;
+
+use super::MAX_COORDINATE;
+use super::error::{SceneFileError, did_you_mean};
+use super::spec::Three;
+
+/// How each required key is written, for "missing key" messages.
+const KEY_FORMS: [(&str, &str); 6] = [
+    ("position", "position = [x, y, z]"),
+    ("power", "power = 14 (or [r, g, b])"),
+    ("colour", "colour = [r, g, b] (each from 0 to 1)"),
+    (
+        "kind",
+        "kind = \"triangles\", \"box\", \"obj\" or \"icosphere\"",
+    ),
+    ("material", "material = \"NAME\" (a [material.NAME] table)"),
+    ("bounces", "bounces = n (0 to 16)"),
+];
+
+/// The file being read: its text and its name, for positioned errors.
+pub struct Ctx<'a> {
+    /// The scene file's text.
+    pub source: &'a str,
+    /// Its name as shown.
+    pub file: &'a str,
+}
+
+impl Ctx<'_> {
+    /// An error at byte `offset`.
+    pub fn err(&self, offset: usize, message: impl Into<String>) -> SceneFileError {
+        SceneFileError::at(self.file, self.source, offset, message)
+    }
+
+    /// An error at `v`.
+    pub fn err_at<T>(&self, v: &Spanned<T>, message: impl Into<String>) -> SceneFileError {
+        self.err(v.span().start, message)
+    }
+
+    /// `v` as an `f32` triple, each component finite and within ±[`MAX_COORDINATE`].
+    pub fn point(&self, v: &Spanned<Three<f64>>, what: &str) -> Result<Vec3, SceneFileError> {
+        for c in &v.get_ref().0 {
+            if !c.is_finite() || c.abs() > MAX_COORDINATE {
+                return Err(self.err_at(
+                    v,
+                    format!(
+                        "{what} has the coordinate {c}: expected finite numbers within ±{MAX_COORDINATE:e}"
+                    ),
+                ));
+            }
+        }
+        Ok(Vec3::from(v.get_ref().0.map(|c| c as f32)))
+    }
+
+    /// A number in `lo..=hi`.
+    pub fn ranged(
+        &self,
+        v: &Spanned<f64>,
+        lo: f64,
+        hi: f64,
+        what: &str,
+    ) -> Result<f64, SceneFileError> {
+        let x = *v.get_ref();
+        if !(x >= lo && x <= hi) {
+            return Err(self.err_at(
+                v,
+                format!("{what} is {x}: expected a number from {lo} to {hi}"),
+            ));
+        }
+        Ok(x)
+    }
+
+    /// A whole number in `lo..=hi`.
+    pub fn whole(
+        &self,
+        v: &Spanned<i64>,
+        lo: i64,
+        hi: i64,
+        what: &str,
+    ) -> Result<i64, SceneFileError> {
+        let x = *v.get_ref();
+        if !(lo..=hi).contains(&x) {
+            return Err(self.err_at(
+                v,
+                format!("{what} is {x}: expected a whole number from {lo} to {hi}"),
+            ));
+        }
+        Ok(x)
+    }
+
+    /// "NAME:LINE:COL" of byte `offset`, to name a place in the scene file from another file's
+    /// error.
+    pub fn place(&self, offset: usize) -> String {
+        let (l, c) = super::line_column(self.source, offset);
+        format!("{}:{l}:{c}", self.file)
+    }
+}
+
+/// A TOML or serde error as a positioned message; unknown keys get a suggestion.
+pub fn toml_error(cx: &Ctx, e: &toml::de::Error) -> SceneFileError {
+    let offset = e.span().map_or(0, |s| s.start);
+    let message = e.message().trim().replace('\n', "; ");
+    let message = if let Some(rest) = message.strip_prefix("unknown field `") {
+        let key = rest.split('`').next().unwrap_or("");
+        let known: Vec<&str> = rest
+            .split('`')
+            .skip(1)
+            .collect::<Vec<_>>()
+            .chunks(2)
+            .filter_map(|c| c.get(1).copied())
+            .collect();
+        format!(
+            "unknown key `{key}`{} (keys here: {})",
+            did_you_mean(key, &known),
+            if known.is_empty() {
+                "none".to_string()
+            } else {
+                known.join(", ")
+            }
+        )
+    } else if let Some(rest) = message.strip_prefix("missing field `") {
+        let key = rest.split('`').next().unwrap_or("");
+        let form = KEY_FORMS
+            .iter()
+            .find(|k| k.0 == key)
+            .map_or(String::new(), |k| format!(": add {}", k.1));
+        format!("missing key `{key}` in this table{form}")
+    } else {
+        message
+            .replace("duplicate field", "duplicate key")
+            .replace(" as i128", "")
+            .replace(
+                "expected an array of length 3",
+                "expected three numbers [a, b, c]",
+            )
+            .replace("expected i64", "expected a whole number")
+            .replace("expected f64", "expected a number")
+            .replace("expected a boolean", "expected true or false")
+            .replace("invalid type: map", "invalid type: table")
+            .replace("invalid type: sequence", "invalid type: array")
+            .replace(
+                "expected a sequence",
+                "expected an array: [a, b, ...], or [[NAME]] tables (double brackets) for a list of tables",
+            )
+            .replace(
+                "expected a map",
+                "expected a table: [NAME] or [NAME.KEY] headers, or { key = value }",
+            )
+    };
+    cx.err(offset, message)
+}
