@@ -390,3 +390,39 @@ fn a_dumb_terminal_gets_one_frame_not_the_app() {
     assert!(shown.contains('▀'), "{shown}");
     assert!(!shown.contains("H:help"), "{shown}");
 }
+
+/// The state letter of process `pid` (`T` when stopped), from /proc.
+#[cfg(target_os = "linux")]
+fn process_state(pid: u32) -> Option<char> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // After the parenthesised command name: " S ...".
+    stat.rsplit_once(')')?.1.trim_start().chars().next()
+}
+
+#[test]
+#[cfg(target_os = "linux")]
+fn ctrl_z_gives_the_terminal_back_and_continuing_redraws() {
+    let mut s = Session::start(40, 12, false);
+    s.wait_for_status(&["indirect"]);
+    let pid = s.child.process_id().expect("pid");
+    s.send(b"\x1a");
+    s.wait_for("the main screen and a visible cursor", |sc| {
+        !sc.alternate_screen() && !sc.hide_cursor()
+    });
+    let deadline = Instant::now() + TIMEOUT;
+    while process_state(pid) != Some('T') {
+        assert!(Instant::now() < deadline, "raytty did not stop on Ctrl-Z");
+        std::thread::yield_now();
+    }
+    let continued = std::process::Command::new("kill")
+        .args(["-CONT", &pid.to_string()])
+        .status()
+        .expect("run kill");
+    assert!(continued.success());
+    s.wait_for("the app's screen again", |sc| {
+        sc.alternate_screen() && sc.hide_cursor()
+    });
+    s.wait_for_status(&["indirect"]);
+    s.send(b"\x1b");
+    assert!(s.finish().success());
+}

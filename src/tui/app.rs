@@ -30,6 +30,8 @@ pub enum Message {
     },
     /// Leave the app.
     Quit,
+    /// Give the terminal back to the shell until it resumes us (Ctrl-Z; `fg` resumes).
+    Suspend,
 }
 
 /// The app's state.
@@ -51,6 +53,8 @@ pub struct App {
     pub size: (u16, u16),
     /// Set by [`Message::Quit`].
     pub quit: bool,
+    /// Set by [`Message::Suspend`]; the event loop suspends and clears it.
+    pub suspend: bool,
     /// Bumped whenever the image's inputs change (camera, lights, stage, size): a progressive
     /// render restarts when it changes.
     pub generation: u64,
@@ -70,6 +74,7 @@ impl App {
             help: false,
             size,
             quit: false,
+            suspend: false,
             generation: 0,
             dirty: true,
         }
@@ -133,6 +138,10 @@ pub fn update(app: &mut App, msg: Message) {
         }
         Message::Quit => {
             app.quit = true;
+            false
+        }
+        Message::Suspend => {
+            app.suspend = true;
             false
         }
     };

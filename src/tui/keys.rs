@@ -27,6 +27,7 @@ pub const KEYS: &[(&str, &str)] = &[
     ("R", "reset camera and light"),
     ("C", "colour mode: truecolor 256 ascii"),
     ("H or ?", "this help"),
+    ("Ctrl-Z", "suspend (fg resumes)"),
     ("Esc, Ctrl-C", "quit"),
 ];
 
@@ -53,6 +54,9 @@ pub fn message_for(key: KeyEvent) -> Option<Message> {
         KeyCode::Esc => Some(Message::Quit),
         KeyCode::Char('c' | 'C') if key.modifiers.contains(KeyModifiers::CONTROL) => {
             Some(Message::Quit)
+        }
+        KeyCode::Char('z' | 'Z') if key.modifiers.contains(KeyModifiers::CONTROL) => {
+            Some(Message::Suspend)
         }
         KeyCode::Up => Some(Message::Walk(walk)),
         KeyCode::Down => Some(Message::Walk(-walk)),

@@ -19,7 +19,7 @@ use anyhow::{Context, Result};
 use crossterm::event::KeyEvent;
 use crossterm::{cursor, execute, terminal};
 use raytty::{ColorMode, Scene};
-use signal_hook::consts::{SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGWINCH};
+use signal_hook::consts::{SIGHUP, SIGINT, SIGQUIT, SIGSTOP, SIGTERM, SIGWINCH};
 use signal_hook::iterator::Signals;
 
 use super::app::{App, Message, update};
@@ -71,17 +71,32 @@ impl Guard {
             restore();
             prev(info);
         }));
-        terminal::enable_raw_mode().context("cannot put the terminal in raw mode")?;
-        ACTIVE.store(true, Ordering::SeqCst);
-        let guard = Guard;
-        execute!(
-            io::stdout(),
-            terminal::EnterAlternateScreen,
-            cursor::Hide,
-            terminal::Clear(terminal::ClearType::All)
-        )?;
-        Ok(guard)
+        take_terminal()?;
+        Ok(Guard)
     }
+}
+
+/// Raw mode, the alternate screen, a hidden cursor and a clear screen; marks the terminal as
+/// needing [`restore`].
+fn take_terminal() -> Result<()> {
+    terminal::enable_raw_mode().context("cannot put the terminal in raw mode")?;
+    ACTIVE.store(true, Ordering::SeqCst);
+    execute!(
+        io::stdout(),
+        terminal::EnterAlternateScreen,
+        cursor::Hide,
+        terminal::Clear(terminal::ClearType::All)
+    )?;
+    Ok(())
+}
+
+/// Ctrl-Z: gives the terminal back as it was, stops the process (as the shell's job control
+/// expects; SIGSTOP, because raw mode turned the key into a byte rather than SIGTSTP), and once
+/// continued (`fg`) takes the terminal again. The caller redraws every cell.
+fn suspend() -> Result<()> {
+    restore();
+    signal_hook::low_level::raise(SIGSTOP).context("cannot suspend")?;
+    take_terminal()
 }
 
 impl Drop for Guard {
@@ -189,6 +204,17 @@ fn event_loop(mut app: App, rx: &Receiver<Input>) -> Result<ExitCode> {
             if let Some(code) = handle(&mut app, input) {
                 return Ok(code);
             }
+        }
+        if app.suspend {
+            out.flush().context("cannot write to the terminal")?;
+            suspend()?;
+            app.suspend = false;
+            // The terminal may have been resized, and shows whatever ran meanwhile.
+            if let Ok((cols, rows)) = terminal::size() {
+                update(&mut app, Message::Resize { cols, rows });
+            }
+            screen.forget_shown();
+            app.dirty = true;
         }
         if screen.needs_render(&app) {
             screen.render(&app);

@@ -81,6 +81,12 @@ impl Screen {
         }
     }
 
+    /// Forgets what the terminal shows, so that the next draw repaints every cell (after the
+    /// terminal was handed to another program, e.g. while suspended).
+    pub fn forget_shown(&mut self) {
+        self.shown = None;
+    }
+
     /// Passes accumulated for the current image.
     pub fn passes(&self) -> u32 {
         self.passes
