@@ -15,13 +15,18 @@ fn image_bytes(threads: usize, stage: Stage, samples: u32) -> Vec<u8> {
         let mut settings = stage.settings(scene.effects);
         settings.effects.samples = samples;
         let f = render(&scene, &scene.camera, &scene.lights, &settings, 64, 48);
-        f.image
-            .pixels
-            .iter()
-            .flat_map(|p| p.to_array())
-            .flat_map(f32::to_le_bytes)
-            .collect()
+        float_bytes(&f.image)
     })
+}
+
+/// An image's exact floats, as little-endian bytes.
+fn float_bytes(image: &raytty::Image) -> Vec<u8> {
+    image
+        .pixels
+        .iter()
+        .flat_map(|p| p.to_array())
+        .flat_map(f32::to_le_bytes)
+        .collect()
 }
 
 #[test]
@@ -104,14 +109,7 @@ fn frames_are_bit_identical_to_the_committed_fingerprints() {
             let mut settings = stage.settings(scene.effects);
             settings.effects.samples = 4;
             let f = render(&scene, &camera, &scene.lights, &settings, 48, 32);
-            let bytes: Vec<u8> = f
-                .image
-                .pixels
-                .iter()
-                .flat_map(|p| p.to_array())
-                .flat_map(f32::to_le_bytes)
-                .collect();
-            (stage, fingerprint(&bytes))
+            (stage, fingerprint(&float_bytes(&f.image)))
         })
         .collect();
     insta::assert_debug_snapshot!(got);

@@ -12,7 +12,7 @@ pub mod reference;
 
 use std::io;
 use std::path::PathBuf;
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use crate::frame::{CellGrid, ColorMode, encode_text};
 use crate::image::Image;
@@ -303,7 +303,6 @@ fn measure(
     let (runs, min_row_time) = (options.runs.max(1), options.min_row_time);
     let settings = kind.settings(scene);
     let once = || {
-        let start = Instant::now();
         let f = render(
             scene,
             &scene.camera,
@@ -312,7 +311,8 @@ fn measure(
             width,
             height,
         );
-        (f, start.elapsed())
+        let t = f.stats.elapsed;
+        (f, t)
     };
     let (frame, _) = once();
     tick();
@@ -331,12 +331,7 @@ fn measure(
     }
     times.sort();
     let ms = |d: Duration| d.as_secs_f64() * 1e3;
-    let mid = times.len() / 2;
-    let median_ms = if times.len() % 2 == 1 {
-        ms(times[mid])
-    } else {
-        0.5 * (ms(times[mid - 1]) + ms(times[mid]))
-    };
+    let median_ms = ms(crate::scene_bench::median(&times));
     let rays = frame.stats.rays;
     Row {
         width,

@@ -162,15 +162,13 @@ impl Screen {
             }
             g
         };
-        let mut body = Vec::new();
-        encode_diff(self.shown.as_ref(), &grid, 0, &mut body);
+        // Encoded straight after the begin marker: the frame is written into place, not copied.
+        let mut out = SYNC_BEGIN.to_vec();
+        encode_diff(self.shown.as_ref(), &grid, 0, &mut out);
         self.shown = Some(grid);
-        if body.is_empty() {
-            return body;
+        if out.len() == SYNC_BEGIN.len() {
+            return Vec::new();
         }
-        let mut out = Vec::with_capacity(body.len() + SYNC_BEGIN.len() + SYNC_END.len());
-        out.extend_from_slice(SYNC_BEGIN);
-        out.extend_from_slice(&body);
         out.extend_from_slice(SYNC_END);
         self.stats.encode = start.elapsed();
         self.stats.bytes = out.len();
