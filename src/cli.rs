@@ -217,14 +217,15 @@ pub fn main() -> ExitCode {
     }
     let cli = Cli::from_arg_matches(&cmd.get_matches()).unwrap_or_else(|e| e.exit());
     let dumb = is_dumb(std::env::var("TERM").ok().as_deref());
+    let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
     let color = resolve_color(
         cli.color,
-        dumb || std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty()),
+        dumb || no_color,
         std::env::var("COLORTERM").ok().as_deref(),
     );
     let result = match cli.command {
         Some(Command::Render(args)) => {
-            run_render(&args, cli.scene.as_deref()).map(|()| ExitCode::SUCCESS)
+            run_render(&args, cli.scene.as_deref(), no_color).map(|()| ExitCode::SUCCESS)
         }
         Some(Command::Scenes) => io::stdout()
             .write_all(crate::scene_arg::list().as_bytes())
@@ -394,11 +395,13 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
             output: None,
         },
         scene,
+        false,
     )?;
     Ok(ExitCode::SUCCESS)
 }
 
-fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
+/// `raytty render`; `no_color` (NO_COLOR is set) makes ascii the default text format.
+fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool) -> Result<()> {
     if let Some(ext) = args.output.as_deref().and_then(unwritable_image_extension) {
         bail!(UsageError(format!(
             "-o {}: raytty cannot write .{ext} images: use a .png or .pfm file name (or --format ascii|ansi|ansi256 for text)",
@@ -408,13 +411,12 @@ fn run_render(args: &RenderArgs, scene: Option<&str>) -> Result<()> {
                 .display()
         )));
     }
-    let format = args.format.unwrap_or_else(|| {
-        let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
-        match format_for(args.output.as_deref()) {
+    let format = args
+        .format
+        .unwrap_or_else(|| match format_for(args.output.as_deref()) {
             Format::Ansi if no_color => Format::Ascii,
             f => f,
-        }
-    });
+        });
     let image_format = matches!(format, Format::Png | Format::Pfm);
     if image_format && args.output.is_none() && io::stdout().is_terminal() {
         bail!(UsageError(format!(
