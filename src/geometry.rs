@@ -8,7 +8,7 @@
 //! surface from an origin pushed out of the hit point's own rounding-error box
 //! ([`offset_ray_origin`]), so no tuned epsilon depends on the scene's scale.
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 
 /// Machine epsilon for `f32` rounding: half an ULP of 1.0.
 const MACHINE_EPSILON: f32 = f32::EPSILON * 0.5;
@@ -499,31 +499,6 @@ impl Aabb {
         }
         true
     }
-}
-
-/// The same test in `f64`, for references in tests and tools: plain Möller–Trumbore with no
-/// epsilon, returning `(t, b1, b2)` for hits with `t > 0`.
-pub fn intersect_f64(origin: DVec3, dir: DVec3, v: [DVec3; 3]) -> Option<(f64, f64, f64)> {
-    let e1 = v[1] - v[0];
-    let e2 = v[2] - v[0];
-    let p = dir.cross(e2);
-    let det = e1.dot(p);
-    if det == 0.0 || !det.is_finite() {
-        return None;
-    }
-    let inv = 1.0 / det;
-    let s = origin - v[0];
-    let u = s.dot(p) * inv;
-    if !(0.0..=1.0).contains(&u) {
-        return None;
-    }
-    let q = s.cross(e1);
-    let w = dir.dot(q) * inv;
-    if w < 0.0 || u + w > 1.0 {
-        return None;
-    }
-    let t = e2.dot(q) * inv;
-    (t > 0.0).then_some((t, u, w))
 }
 
 #[cfg(test)]
