@@ -12,14 +12,7 @@ fn every_pixel_of_the_seed_view_hits_the_box() {
         if stage == Stage::Gi {
             settings.effects.samples = 1;
         }
-        let frame = render(
-            &scene,
-            &scene.camera(),
-            scene.lights(),
-            &settings,
-            500,
-            500,
-        );
+        let frame = render(&scene, &scene.camera(), scene.lights(), &settings, 500, 500);
         assert_eq!(frame.stats.rays.primary, 250_000);
         for (i, p) in frame.image.pixels.iter().enumerate() {
             assert!(p.is_finite(), "{stage:?}: pixel {i} is {p}");
