@@ -419,13 +419,13 @@ mod tests {
     #[test]
     fn a_wide_name_is_measured_in_columns() {
         let mut a = app(40, 5);
-        a.scene.name = "漢".repeat(200);
+        a.scene = a.scene.with_name("漢".repeat(200));
         let s = Screen::new();
         let line = s.status(&a);
         assert!(line.starts_with(" 漢漢"), "{line:?}");
         // Only the rank-0 fields: the name is clipped when drawn, never wrapped.
         assert!(!line.contains("H:help"), "{line:?}");
-        a.scene.name = "漢字".into();
+        a.scene = a.scene.with_name("漢字");
         let line = s.status(&a);
         assert!(
             text_width(&line) <= 40 && line.contains("H:help"),
