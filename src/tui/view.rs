@@ -416,16 +416,26 @@ mod tests {
         }
     }
 
+    /// An app showing a one-box scene called `name`.
+    fn named(name: &str, cols: u16, rows: u16) -> App {
+        let source = format!(
+            "name = \"{name}\"\n[material.m]\ncolour = [1, 1, 1]\n[[object]]\nkind = \"box\"\nmaterial = \"m\"\ncentre = [0, 0, 0]\nsize = [1, 1, 1]\n"
+        );
+        let scene =
+            raytty::scene::file::parse(&source, "t.toml", "t", &raytty::scene::file::no_meshes)
+                .unwrap();
+        App::new(scene, ColorMode::TrueColor, (cols, rows))
+    }
+
     #[test]
     fn a_wide_name_is_measured_in_columns() {
-        let mut a = app(40, 5);
-        a.scene = a.scene.with_name("漢".repeat(200));
+        let a = named(&"漢".repeat(200), 40, 5);
         let s = Screen::new();
         let line = s.status(&a);
         assert!(line.starts_with(" 漢漢"), "{line:?}");
         // Only the rank-0 fields: the name is clipped when drawn, never wrapped.
         assert!(!line.contains("H:help"), "{line:?}");
-        a.scene = a.scene.with_name("漢字");
+        let a = named("漢字", 40, 5);
         let line = s.status(&a);
         assert!(
             text_width(&line) <= 40 && line.contains("H:help"),
