@@ -21,7 +21,7 @@ fn main() {
     let reference = read_pfm(&std::fs::read(&path).unwrap()).unwrap();
     let scene = cornell_box();
     for spp in [1, 4, 16] {
-        let mut s = Stage::Gi.settings(scene.effects);
+        let mut s = Stage::Gi.settings(scene.effects());
         s.effects.samples = spp;
         let mut times = Vec::new();
         let mut dtimes = Vec::new();
@@ -30,8 +30,8 @@ fn main() {
             let t = Instant::now();
             let f = render_guided(
                 &scene,
-                &scene.camera,
-                &scene.lights,
+                &scene.camera(),
+                scene.lights(),
                 &s,
                 w,
                 h,

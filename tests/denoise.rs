@@ -15,7 +15,7 @@ use raytty::{
 
 fn gi(spp: u32, frame: u32) -> Settings {
     let scene = cornell_box();
-    let mut s = Stage::Gi.settings(scene.effects);
+    let mut s = Stage::Gi.settings(scene.effects());
     s.effects.samples = spp;
     s.frame = frame;
     s
@@ -24,8 +24,8 @@ fn gi(spp: u32, frame: u32) -> Settings {
 fn guided(scene: &Scene, settings: &Settings, w: u32, h: u32) -> (Image, Guides) {
     let f = render_guided(
         scene,
-        &scene.camera,
-        &scene.lights,
+        &scene.camera(),
+        scene.lights(),
         settings,
         w,
         h,
@@ -42,7 +42,7 @@ fn rmse(a: &Image, b: &Image) -> f64 {
 fn mean_of_frames(scene: &Scene, w: u32, h: u32, first: u32, frames: u32) -> Image {
     let mut sum = vec![DVec3::ZERO; (w * h) as usize];
     for f in first..first + frames {
-        let img = render(scene, &scene.camera, &scene.lights, &gi(1, f), w, h).image;
+        let img = render(scene, &scene.camera(), scene.lights(), &gi(1, f), w, h).image;
         for (s, p) in sum.iter_mut().zip(&img.pixels) {
             *s += p.as_dvec3();
         }
@@ -62,7 +62,7 @@ fn guided_frames_are_the_plain_frames() {
     let scene = cornell_box();
     for spp in [1, 4] {
         let (img, g) = guided(&scene, &gi(spp, 3), 40, 30);
-        let plain = render(&scene, &scene.camera, &scene.lights, &gi(spp, 3), 40, 30).image;
+        let plain = render(&scene, &scene.camera(), scene.lights(), &gi(spp, 3), 40, 30).image;
         assert_eq!(img, plain, "{spp} spp");
         assert_eq!(g.samples, spp);
         // The guides add up to the same image (up to the rounding of a mean of parts).
@@ -177,8 +177,8 @@ impl Unrouletted<'_> {
         let Some(hit) = self.scene.intersect(ray, f32::INFINITY) else {
             return Vec3::ZERO;
         };
-        let tri = &self.scene.triangles[hit.triangle as usize];
-        let rho = self.scene.materials[tri.material as usize].colour;
+        let tri = &self.scene.triangles()[hit.triangle as usize];
+        let rho = self.scene.materials()[tri.material as usize].colour;
         let (p, err) = hit_point(&tri.v, hit.b);
         let normal = if tri.normal.dot(ray.dir) > 0.0 {
             -tri.normal
@@ -216,8 +216,8 @@ fn the_raw_path_is_unbiased() {
     let frames = 512;
     let raw = mean_of_frames(&scene, w, h, 0, frames);
     // The direct part, exact at pixel centres: what is left is the indirect light alone.
-    let shadows = Stage::Shadows.settings(scene.effects);
-    let direct = render(&scene, &scene.camera, &scene.lights, &shadows, w, h)
+    let shadows = Stage::Shadows.settings(scene.effects());
+    let direct = render(&scene, &scene.camera(), scene.lights(), &shadows, w, h)
         .image
         .pixels
         .iter()
@@ -227,9 +227,9 @@ fn the_raw_path_is_unbiased() {
     let settings = gi(1, 0);
     let u = Unrouletted {
         scene: &scene,
-        tracer: Tracer::new(&scene, &scene.lights, settings),
+        tracer: Tracer::new(&scene, scene.lights(), settings),
     };
-    let rays = scene.camera.rays(w, h);
+    let rays = scene.camera().rays(w, h);
     let mut sum = DVec3::ZERO;
     let mut n = RayCounts::default();
     for y in 0..h {
