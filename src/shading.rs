@@ -219,8 +219,8 @@ impl<'a> Tracer<'a> {
         rng: &mut Rng,
         n: &mut RayCounts,
     ) -> Vec3 {
-        let tri = &self.scene.triangles[hit.triangle as usize];
-        let material = &self.scene.materials[tri.material as usize];
+        let tri = &self.scene.triangles()[hit.triangle as usize];
+        let material = &self.scene.materials()[tri.material as usize];
         if self.settings.mode == Mode::Flat {
             return material.colour;
         }

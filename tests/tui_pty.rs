@@ -164,11 +164,11 @@ impl Drop for Session {
 /// of image (the status line is not included).
 fn expected(cols: u16, rows: u16, camera_z: f32, light_y: f32) -> CellGrid {
     let scene = cornell_box();
-    let mut camera = scene.camera;
+    let mut camera = scene.camera();
     camera.position += camera.forward() * camera_z;
-    let mut lights = scene.lights.clone();
+    let mut lights = scene.lights().to_vec();
     lights[0].position += camera.to_world(Vec3::new(0.0, light_y, 0.0));
-    let settings = Stage::Indirect.settings(scene.effects);
+    let settings = Stage::Indirect.settings(scene.effects());
     let frame = render(
         &scene,
         &camera,

@@ -154,9 +154,9 @@ impl RowKind {
     /// The settings the row renders with.
     pub fn settings(&self, scene: &Scene) -> Settings {
         match *self {
-            RowKind::Stage(s) => s.settings(scene.effects),
+            RowKind::Stage(s) => s.settings(scene.effects()),
             RowKind::Aa { spp } => {
-                let mut s = Stage::Indirect.settings(scene.effects);
+                let mut s = Stage::Indirect.settings(scene.effects());
                 s.effects.samples = spp;
                 s
             }
@@ -306,8 +306,8 @@ fn measure(
     let once = || {
         let f = render(
             scene,
-            &scene.camera,
-            &scene.lights,
+            &scene.camera(),
+            scene.lights(),
             &settings,
             width,
             height,

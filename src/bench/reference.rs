@@ -46,7 +46,7 @@ impl ReferenceSpec {
     /// The spec for `scene` at `width`×`height`, with `spp` rounded up to whole passes.
     pub fn new(scene: &Scene, width: u32, height: u32, spp: u32, bounces: u32) -> ReferenceSpec {
         ReferenceSpec {
-            scene: scene.name.clone(),
+            scene: scene.name().to_string(),
             width,
             height,
             spp: spp.max(1).div_ceil(PASS_SPP) * PASS_SPP,
@@ -229,8 +229,8 @@ pub fn load_or_render(
     for pass in done..passes {
         let frame = render(
             scene,
-            &scene.camera,
-            &scene.lights,
+            &scene.camera(),
+            scene.lights(),
             &spec.settings(pass),
             spec.width,
             spec.height,

@@ -60,7 +60,7 @@ pub struct SceneBench {
 /// one) at each size with the scene's own camera, lights and effects, after one untimed frame.
 pub fn bench_scene(scene: &Scene, sizes: &[(u32, u32)], runs: u32) -> SceneBench {
     let accel = scene.build_accel(scene.accel_stats().kind).stats();
-    let settings = Stage::Indirect.settings(scene.effects);
+    let settings = Stage::Indirect.settings(scene.effects());
     let runs = runs.max(1);
     let sizes = sizes
         .iter()
@@ -68,8 +68,8 @@ pub fn bench_scene(scene: &Scene, sizes: &[(u32, u32)], runs: u32) -> SceneBench
             let frame = || {
                 render(
                     scene,
-                    &scene.camera,
-                    &scene.lights,
+                    &scene.camera(),
+                    scene.lights(),
                     &settings,
                     width,
                     height,
@@ -96,7 +96,7 @@ pub fn bench_scene(scene: &Scene, sizes: &[(u32, u32)], runs: u32) -> SceneBench
         })
         .collect();
     SceneBench {
-        scene: scene.name.clone(),
+        scene: scene.name().to_string(),
         accel,
         threads: rayon::current_num_threads(),
         sizes,

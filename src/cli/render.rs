@@ -53,18 +53,18 @@ pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool)
         )));
     }
     let scene = crate::cli::scene_arg::load_scene(scene)?;
-    let mut camera = scene.camera;
+    let mut camera = scene.camera();
     if let Some([x, y, z, yaw]) = args.camera {
         camera.position = Vec3::new(x, y, z);
         camera.yaw = yaw.to_radians();
     }
-    if args.light.is_some() && scene.lights.is_empty() {
+    if args.light.is_some() && scene.lights().is_empty() {
         bail!(UsageError(
             "--light moves the scene's first light, and this scene has none: add a [[light]] to the scene file".into()
         ));
     }
     let lights = lights_with(&scene, args.light);
-    let mut settings = args.stage.settings(scene.effects);
+    let mut settings = args.stage.settings(scene.effects());
     if let Some(n) = args.samples {
         settings.effects.samples = n;
     }
@@ -151,7 +151,7 @@ pub(super) fn format_name(format: Format) -> String {
 
 /// The scene's lights, with the first one moved to `light` if given.
 pub(super) fn lights_with(scene: &Scene, light: Option<Vec3>) -> Vec<PointLight> {
-    let mut lights = scene.lights.clone();
+    let mut lights = scene.lights().to_vec();
     if let (Some(p), Some(first)) = (light, lights.first_mut()) {
         first.position = p;
     }

@@ -110,7 +110,7 @@ impl Screen {
             self.passes = 0;
             self.sum.clear();
         }
-        let mut settings = app.stage.settings(app.scene.effects);
+        let mut settings = app.stage.settings(app.scene.effects());
         settings.frame = self.passes;
         let frame = render_cached(
             &app.scene,
@@ -189,7 +189,7 @@ impl Screen {
         let light = app.light().map_or_else(|| "none".into(), xyz);
         // (text, rank): rank 0 is always shown, then the lowest ranks first while they fit.
         let fields = [
-            (printable(&app.scene.name), 0),
+            (printable(app.scene.name()), 0),
             (format!("{key}:{}{spp}", app.stage.name()), 0),
             (
                 format!(
