@@ -1,6 +1,7 @@
 //! Command-line parsing and the non-interactive commands. The exit code is chosen here, once:
 //! 0 for success (a closed output pipe included), 1 for a failure while running, 2 for bad
-//! input (clap's own usage errors are 2 as well).
+//! input (clap's own usage errors are 2 as well), and for the app 128 + N after signal N
+//! ([`signal_status`]; a dropped terminal counts as SIGHUP).
 
 mod args;
 mod bench;
@@ -59,6 +60,25 @@ pub fn main() -> ExitCode {
     }
 }
 
+/// The exit status of a run ended by signal `sig`: 128 + N, as shells report it. The app's
+/// forced exit after a signal (when its loop cannot return in time) uses this too.
+#[cfg(feature = "tui")]
+pub fn signal_status(sig: i32) -> u8 {
+    (128 + sig).clamp(0, 255) as u8
+}
+
+/// The exit status of the app: 0 on quit, [`signal_status`] of the signal, and for a dropped
+/// terminal that of SIGHUP (129), as if the hangup had been signalled.
+#[cfg(feature = "tui")]
+fn app_status(outcome: crate::tui::Outcome) -> ExitCode {
+    use crate::tui::Outcome;
+    match outcome {
+        Outcome::Quit => ExitCode::SUCCESS,
+        Outcome::Signal(sig) => ExitCode::from(signal_status(sig)),
+        Outcome::Hangup => ExitCode::from(signal_status(libc::SIGHUP)),
+    }
+}
+
 /// An error in what the user asked for (exit status 2).
 #[derive(Debug)]
 pub struct UsageError(pub String);
@@ -103,7 +123,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
             if note {
                 eprint!("\r\x1b[2K");
             }
-            return crate::tui::run(loaded?, color);
+            return crate::tui::run(loaded?, color).map(app_status);
         }
         eprintln!("raytty: TERM=dumb cannot run the app (it moves the cursor): one frame follows");
     }
