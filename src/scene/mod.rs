@@ -273,6 +273,13 @@ impl Scene {
         &self.name
     }
 
+    /// The same scene under another display name (names are shown through
+    /// [`crate::printable`], so any string is safe).
+    pub fn with_name(mut self, name: impl Into<String>) -> Scene {
+        self.name = name.into();
+        self
+    }
+
     /// All triangles, each finite with a unit normal; [`Hit::triangle`] indexes this.
     pub fn triangles(&self) -> &[Triangle] {
         &self.triangles
