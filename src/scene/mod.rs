@@ -18,6 +18,11 @@ use crate::accel::{Accel, AccelKind, AccelStats, Hit};
 use crate::camera::Camera;
 use crate::geometry::{Aabb, DegenerateTriangle, Ray, Triangle};
 
+/// Largest absolute coordinate accepted anywhere a user gives one (scene files, OBJ vertices,
+/// `--camera` and `--light`; box corners and transformed vertices too): far beyond any sensible
+/// scene, far below where `f32` loses whole units. Exact in `f32` and `f64`.
+pub const MAX_COORDINATE: f32 = 1e6;
+
 /// A surface's material.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
