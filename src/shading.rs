@@ -290,8 +290,17 @@ impl<'a> Tracer<'a> {
         } else {
             tri.normal
         };
-        let direct = self.direct(p, err, normal, n);
-        let irradiance = self.indirect(p, err, normal, material, mirror_depth, 0, rng, n);
+        let reflects = material.mirror > 0.0 && mirror_depth < MAX_MIRROR_DEPTH;
+        // As in `shade`: a perfect mirror's own shading and a black surface's cost no ray.
+        let (direct, irradiance) =
+            if (reflects && material.mirror >= 1.0) || material.colour == Vec3::ZERO {
+                (Vec3::ZERO, Vec3::ZERO)
+            } else {
+                (
+                    self.direct(p, err, normal, n),
+                    self.indirect(material, p, err, normal, mirror_depth, 0, rng, n),
+                )
+            };
         let own = SplitSample {
             rest: material.colour * direct,
             albedo: material.colour,
@@ -303,7 +312,7 @@ impl<'a> Tracer<'a> {
                 reflections: mirror_depth,
             }),
         };
-        if !(material.mirror > 0.0 && mirror_depth < MAX_MIRROR_DEPTH) {
+        if !reflects {
             return own;
         }
         let m = material.mirror;
@@ -371,13 +380,20 @@ impl<'a> Tracer<'a> {
         } else {
             tri.normal
         };
-        let direct = self.direct(p, err, normal, n);
         if self.settings.mode == Mode::Irradiance {
-            return direct;
+            return self.direct(p, err, normal, n);
         }
-        let indirect = self.indirect(p, err, normal, material, mirror_depth, bounce, rng, n);
-        let diffuse = material.colour * (direct + indirect);
-        if material.mirror > 0.0 && mirror_depth < MAX_MIRROR_DEPTH {
+        let reflects = material.mirror > 0.0 && mirror_depth < MAX_MIRROR_DEPTH;
+        // What cannot change the pixel is not traced: a perfect mirror's own shading is
+        // weighted by 1 − mirror = 0, and a black surface's by ρ = 0.
+        let diffuse = if (reflects && material.mirror >= 1.0) || material.colour == Vec3::ZERO {
+            Vec3::ZERO
+        } else {
+            material.colour
+                * (self.direct(p, err, normal, n)
+                    + self.indirect(material, p, err, normal, mirror_depth, bounce, rng, n))
+        };
+        if reflects {
             let d = ray.dir.normalize();
             let dir = d - 2.0 * d.dot(normal) * normal;
             let origin = offset_ray_origin(p, err, normal, dir);
@@ -389,15 +405,15 @@ impl<'a> Tracer<'a> {
         }
     }
 
-    /// The indirect irradiance at `p` (error bound `err`, facing normal `normal`) on
-    /// `material`: nothing, the seed's constant, or one path-traced estimate.
+    /// The indirect irradiance at a diffuse hit: the seed's constant, or one path-traced
+    /// bounce (with Russian roulette past [`ROULETTE_START`] bounces).
     #[allow(clippy::too_many_arguments)]
     fn indirect(
         &self,
+        material: &Material,
         p: Vec3,
         err: Vec3,
         normal: Vec3,
-        material: &Material,
         mirror_depth: u32,
         bounce: u32,
         rng: &mut Rng,
@@ -434,6 +450,10 @@ impl<'a> Tracer<'a> {
     pub fn direct(&self, p: glam::Vec3, err: Vec3, normal: Vec3, n: &mut RayCounts) -> Vec3 {
         let mut sum = Vec3::ZERO;
         for light in self.lights {
+            // A dark light adds nothing: no shadow ray for it.
+            if light.power == Vec3::ZERO {
+                continue;
+            }
             let to_light = light.position - p;
             let dist2 = to_light.length_squared();
             if !(dist2 > 0.0) {
