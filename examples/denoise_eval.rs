@@ -4,7 +4,6 @@
 use std::time::Instant;
 
 use raytty::bench::metrics::rmse;
-use raytty::bench::reference::read_pfm;
 use raytty::denoise::denoise;
 use raytty::{HitCache, Stage, cornell_box, render_guided};
 
@@ -18,7 +17,7 @@ fn main() {
             std::env::var("HOME").unwrap()
         )
     });
-    let reference = read_pfm(&std::fs::read(&path).unwrap()).unwrap();
+    let reference = raytty::Image::read_pfm(&std::fs::read(&path).unwrap()).unwrap();
     let scene = cornell_box();
     for spp in [1, 4, 16] {
         let mut s = Stage::Gi.settings(scene.effects());
