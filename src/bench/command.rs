@@ -5,7 +5,7 @@ use std::fmt;
 use std::io::{self, Write};
 use std::path::PathBuf;
 
-use super::{BenchOptions, csv, markdown, rewrite_readme, run, svg};
+use super::{BenchOptions, Progress, csv, markdown, rewrite_readme, run, svg};
 use crate::scene::Scene;
 
 /// Most pixels one bench size may have (4096×4096): a bench row renders its size several times.
@@ -98,12 +98,13 @@ fn io_error(what: impl Into<String>) -> impl FnOnce(io::Error) -> BenchError {
 }
 
 /// Runs the bench on `scene`: the table (or CSV) goes to `out`, how each reference was made and
-/// where it is cached to `log`, and the SVG and README to their files.
+/// where it is cached to `log`, progress to `progress`, and the SVG and README to their files.
 pub fn run_command(
     scene: &Scene,
     request: &BenchRequest,
     out: &mut dyn Write,
     log: &mut dyn Write,
+    progress: &mut dyn Progress,
 ) -> Result<(), BenchError> {
     let options = request.options();
     for &(w, h) in &options.sizes {
@@ -125,7 +126,7 @@ pub fn run_command(
         }
         None => None,
     };
-    let report = run(scene, &options).map_err(io_error(format!(
+    let report = run(scene, &options, progress).map_err(io_error(format!(
         "cannot cache the reference in {}",
         options.cache_dir.display()
     )))?;

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
+use raytty::scene::MAX_COORDINATE;
 use raytty::{ColorMode, Stage};
 
 /// Renders the Cornell box (or another scene) by ray tracing, in the terminal.
@@ -188,9 +189,9 @@ pub(super) fn parse_floats<const N: usize>(s: &str, what: &str) -> Result<[f32; 
             .trim()
             .parse()
             .map_err(|_| format!("'{p}' in '{s}' is not a number"))?;
-        if !o.is_finite() || o.abs() > 1e6 {
+        if !o.is_finite() || o.abs() > MAX_COORDINATE {
             return Err(format!(
-                "'{p}' in '{s}' is out of range: expected a finite number within ±1e6"
+                "'{p}' in '{s}' is out of range: expected a finite number within ±{MAX_COORDINATE:e}"
             ));
         }
     }

@@ -6,6 +6,7 @@ use anyhow::{Result, bail};
 
 use super::UsageError;
 use super::args::*;
+use super::progress::Bar;
 
 /// `raytty bench`: with no `--scene`, the accuracy price list of the Cornell box; with
 /// `--scene`, what that scene costs (load and acceleration build, frame times, M rays/s).
@@ -80,6 +81,7 @@ pub(super) fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
         &request,
         &mut io::stdout().lock(),
         &mut io::stderr().lock(),
+        &mut Bar::default(),
     )
     .map_err(|e| match e {
         raytty::bench::BenchError::Usage(m) => UsageError(m).into(),

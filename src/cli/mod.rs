@@ -5,10 +5,13 @@
 
 mod args;
 mod bench;
+mod progress;
 mod render;
 pub mod scene_arg;
 
-use std::io::{self, IsTerminal, Write};
+#[cfg(feature = "tui")]
+use std::io::IsTerminal;
+use std::io::{self, Write};
 use std::process::ExitCode;
 
 use anyhow::Result;

@@ -18,6 +18,11 @@ use crate::accel::{Accel, AccelKind, AccelStats, Hit};
 use crate::camera::Camera;
 use crate::geometry::{Aabb, DegenerateTriangle, Ray, Triangle};
 
+/// Largest absolute coordinate accepted anywhere a user gives one (scene files, OBJ vertices,
+/// `--camera` and `--light`; box corners and transformed vertices too): far beyond any sensible
+/// scene, far below where `f32` loses whole units. Exact in `f32` and `f64`.
+pub const MAX_COORDINATE: f32 = 1e6;
+
 /// A surface's material.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -266,6 +271,13 @@ impl Scene {
     /// A short name for display (e.g. "cornell").
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// The same scene under another display name (names are shown through
+    /// [`crate::printable`], so any string is safe).
+    pub fn with_name(mut self, name: impl Into<String>) -> Scene {
+        self.name = name.into();
+        self
     }
 
     /// All triangles, each finite with a unit normal; [`Hit::triangle`] indexes this.
