@@ -316,3 +316,99 @@ fn gi_is_the_same_with_one_thread_and_two() {
     assert_eq!(one.image, two.image);
     assert_eq!(one.stats.rays, two.stats.rays);
 }
+
+/// A wall filling the view with `material`, lit from in front of it.
+fn wall_of(material: Material) -> Scene {
+    let mut b = SceneBuilder::new();
+    let m = b.material(material);
+    let v = |x, y, z| Vec3::new(x, y, z);
+    b.object(
+        [
+            [v(-9., -9., 1.), v(9., -9., 1.), v(9., 9., 1.)],
+            [v(-9., -9., 1.), v(9., 9., 1.), v(-9., 9., 1.)],
+        ],
+        m,
+    );
+    b.light(PointLight {
+        position: v(0.3, -0.2, 0.0),
+        power: Vec3::splat(14.0),
+    });
+    b.build("wall", Camera::default(), Effects::SEED)
+        .expect("valid")
+}
+
+/// A perfect mirror (mirror = 1) shows only what it reflects: its own direct and indirect light
+/// would be weighted by 0, so neither a shadow ray nor a bounce ray is traced for it; and a
+/// black surface (ρ = 0) likewise. A half mirror and a grey wall are the controls.
+#[test]
+fn a_perfect_mirror_or_a_black_surface_traces_no_shadow_or_bounce_ray() {
+    let px = u64::from(W * H);
+    let mirror = |m| Material {
+        colour: Vec3::splat(0.75),
+        mirror: m,
+    };
+    for indirect in [Indirect::Constant(0.5), GI4] {
+        let s = stats(&wall_of(mirror(1.0)), &settings(true, indirect, 1));
+        assert_eq!(s.rays.primary, px, "{indirect:?}");
+        assert_eq!(s.rays.reflection, px, "{indirect:?}: every pixel reflects");
+        assert_eq!((s.rays.shadow, s.rays.bounce), (0, 0), "{indirect:?}");
+        let black = stats(
+            &wall_of(Material::diffuse(Vec3::ZERO)),
+            &settings(true, indirect, 1),
+        );
+        assert_eq!(
+            (black.rays.shadow, black.rays.bounce),
+            (0, 0),
+            "{indirect:?}"
+        );
+        // The controls.
+        let half = stats(&wall_of(mirror(0.5)), &settings(true, indirect, 1));
+        assert_eq!(half.rays.shadow, px, "{indirect:?}");
+        let grey = stats(
+            &wall_of(Material::diffuse(Vec3::splat(0.5))),
+            &settings(true, indirect, 1),
+        );
+        assert_eq!(grey.rays.shadow, px, "{indirect:?}");
+        if indirect == GI4 {
+            assert_eq!(half.rays.bounce, px);
+            assert_eq!(grey.rays.bounce, px);
+        }
+    }
+    // What the mirror shows is unchanged: the reflected rays leave the scene, so it is black.
+    let wall = wall_of(mirror(1.0));
+    let f = render(
+        &wall,
+        &wall.camera(),
+        wall.lights(),
+        &settings(true, GI4, 1),
+        W,
+        H,
+    );
+    assert!(f.image.pixels.iter().all(|p| *p == Vec3::ZERO));
+}
+
+/// A light of zero power adds nothing, so it costs no shadow ray, and the frame is the one
+/// without it, bit for bit.
+#[test]
+fn a_dark_light_costs_no_shadow_ray() {
+    let scene = cornell_box();
+    let lit = scene.lights().to_vec();
+    let dark = PointLight {
+        position: lit[0].position + Vec3::new(0.1, 0.0, 0.0),
+        power: Vec3::ZERO,
+    };
+    for stage in Stage::ALL {
+        let s = stage.settings(scene.effects());
+        let frame = |lights: &[PointLight]| render(&scene, &scene.camera(), lights, &s, W, H);
+        let alone = frame(&[dark]);
+        assert_eq!(alone.stats.rays.shadow, 0, "{stage:?}");
+        assert_eq!(alone.image, frame(&[]).image, "{stage:?}");
+        let both = frame(&[lit[0], dark]);
+        let one = frame(&lit);
+        assert_eq!(both.stats.rays, one.stats.rays, "{stage:?}");
+        assert_eq!(both.image, one.image, "{stage:?}");
+    }
+    // The control: the same light with power casts shadow rays.
+    let s = stats(&scene, &settings(true, Indirect::Constant(0.5), 1));
+    assert!(s.rays.shadow > 0);
+}

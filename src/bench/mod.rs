@@ -24,7 +24,7 @@ use crate::render::render;
 use crate::scene::{Effects, Indirect, Scene};
 use crate::shading::{Mode, RayCounts, Settings, Stage};
 
-pub use command::{BenchError, BenchRequest, run_command};
+pub use command::{BenchError, BenchRequest, check_sizes, run_command};
 pub use output::{csv, markdown, rewrite_readme, svg};
 pub use progress::{NoProgress, Progress};
 pub use reference::{ReferenceInfo, ReferenceSpec};
