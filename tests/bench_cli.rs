@@ -121,6 +121,27 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
     assert!(again.status.success());
     assert!(text(&again.stdout).contains("read from the cache"));
     assert!(text(&again.stderr).contains("read from the cache"));
+    // A corrupt cache file (a header whose size overflows) is refused with a message on
+    // stderr, and rendered again.
+    let file = std::fs::read_dir(&cache)
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    std::fs::write(&file, "PF\n4294967295 4294967295\n-1.0\n\0\0\0\0").unwrap();
+    let repaired = bench(&dir.0, &[]);
+    let stderr = text(&repaired.stderr);
+    assert!(repaired.status.success(), "{stderr}");
+    let name = file.file_name().unwrap().to_string_lossy().into_owned();
+    assert!(
+        stderr
+            .lines()
+            .any(|l| l.contains(&name) && l.contains("refused") && l.contains("bytes of pixels")),
+        "{stderr}"
+    );
+    assert!(stderr.contains("rendered in"), "{stderr}");
+    assert!(std::fs::metadata(&file).unwrap().len() > 40 * 16 * 12);
 }
 
 #[test]
