@@ -232,6 +232,57 @@ fn output_failures_are_one_line_with_status_1() {
     }
 }
 
+/// Runs `raytty ARGS` through `sh` with stdout closed (`>&-`), as a shell user would.
+#[cfg(unix)]
+fn with_stdout_closed(args: &str) -> Output {
+    Command::new("sh")
+        .arg("-c")
+        .arg(format!("exec \"$0\" {args} >&-"))
+        .arg(env!("CARGO_BIN_EXE_raytty"))
+        .output()
+        .unwrap()
+}
+
+#[cfg(unix)]
+#[test]
+fn a_closed_stdout_is_an_error_and_a_closed_pipe_is_not() {
+    // Closed before raytty started: nothing can be written, so exit status 1 and a message
+    // (the bare command too, which prints one frame when stdout is not a terminal).
+    for args in ["render --format ascii --size 8x4", "--color ascii"] {
+        let out = with_stdout_closed(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args}: {err}");
+        assert_eq!(
+            err,
+            "raytty: stdout is closed: there is nowhere to write the frame (redirect it, or give -o FILE)\n"
+        );
+    }
+    // With -o the frame does not go to stdout, so a closed one does not matter.
+    let file = std::env::temp_dir().join(format!("raytty-closed-{}.txt", std::process::id()));
+    let out = with_stdout_closed(&format!("render --size 8x4 -o {}", file.display()));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(std::fs::metadata(&file).unwrap().len() > 0);
+    let _ = std::fs::remove_file(&file);
+    // A pipe whose reader goes away (`raytty render | head -c 1`) is not a failure: the frame
+    // (about 400 KB) fills the pipe, the reader closes it unread, and the write fails with
+    // EPIPE.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_raytty"))
+        .args(["render", "--format", "ansi", "--size", "200x100"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.is_empty(), "{err}");
+}
+
 #[test]
 fn a_bench_file_error_says_its_cause_once() {
     let cache = std::env::temp_dir().join(format!("raytty-cli-cache-{}", std::process::id()));
