@@ -37,8 +37,8 @@ fn text(b: &[u8]) -> String {
 }
 
 /// Rows per size: 5 seed stages, AA at 4 and 16 spp, GI at 4 bounce counts × the quick ladder
-/// (1 and 4 spp).
-const ROWS_PER_SIZE: usize = 5 + 2 + 4 * 2;
+/// (1 and 4 spp), then stage 6 raw and denoised at 1 and 4 spp.
+const ROWS_PER_SIZE: usize = 5 + 2 + 4 * 2 + 2 * 2;
 const SIZES: usize = 2;
 
 #[test]
@@ -49,6 +49,14 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
     let stdout = text(&out.stdout);
     let table: Vec<&str> = stdout.lines().filter(|l| l.starts_with('|')).collect();
     assert_eq!(table.len(), 2 + SIZES * ROWS_PER_SIZE, "{stdout}");
+    assert_eq!(
+        table
+            .iter()
+            .filter(|l| l.contains("| GI + denoiser |"))
+            .count(),
+        2 * SIZES
+    );
+    assert_eq!(stdout.matches("\n- GI + denoiser at ").count(), SIZES);
     let header: Vec<&str> = table[0]
         .trim_matches('|')
         .split('|')
@@ -217,9 +225,11 @@ fn the_svg_is_well_formed_with_one_polyline_per_bounce_count() {
     assert!(svg.starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\""));
     let names = elements(&svg);
     assert_eq!(names[0], "svg");
-    assert_eq!(names.iter().filter(|n| *n == "polyline").count(), 4 * SIZES);
-    for b in [1, 2, 4, 8] {
-        let tag = format!("data-bounces=\"{b}\" points=\"");
+    // Raw GI at 1, 2, 4, 8 and stage 6's roulette cap (16) bounces, and GI + denoiser.
+    assert_eq!(names.iter().filter(|n| *n == "polyline").count(), 6 * SIZES);
+    assert_eq!(svg.matches("polyline class=\"denoised\"").count(), SIZES);
+    for b in [1, 2, 4, 8, 16] {
+        let tag = format!("class=\"gi\" data-bounces=\"{b}\" points=\"");
         let lines: Vec<&str> = svg.lines().filter(|l| l.contains(&tag)).collect();
         assert_eq!(lines.len(), SIZES, "{b} bounces");
         for l in lines {

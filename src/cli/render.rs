@@ -6,6 +6,7 @@ use std::io::{self, BufWriter, IsTerminal, Write};
 use anyhow::Context;
 use clap::ValueEnum;
 use glam::Vec3;
+use raytty::denoise::render_denoised;
 use raytty::{CellGrid, ColorMode, PointLight, Scene, encode_text, render};
 
 use raytty::image::MAX_PIXELS;
@@ -83,7 +84,11 @@ pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool)
         )),
         None => Box::new(BufWriter::new(io::stdout().lock())),
     };
-    let frame = render(&scene, &camera, &lights, &settings, w, h);
+    let frame = if args.denoise == Switch::On {
+        render_denoised(&scene, &camera, &lights, &settings, w, h)
+    } else {
+        render(&scene, &camera, &lights, &settings, w, h)
+    };
     let written = match format {
         Format::Png => frame.image.write_png(&mut out),
         Format::Pfm => frame.image.write_pfm(&mut out),
