@@ -153,6 +153,40 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
 }
 
 #[test]
+fn the_plot_draws_each_size_in_braille_with_every_series_marked() {
+    let dir = TempDir::new("plot");
+    let out = bench(&dir.0, &["--plot"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let (_, chart) = stdout
+        .split_once("\n40x40: RMSE")
+        .expect("a panel per size");
+    assert!(chart.contains("\n32x16: RMSE"), "{chart}");
+    assert!(
+        chart
+            .chars()
+            .any(|c| ('\u{2801}'..='\u{28ff}').contains(&c)),
+        "{chart}"
+    );
+    for mark in [
+        "1 GI, 1 bounce",
+        "D GI + denoiser",
+        "R GI, roulette",
+        "+ goal",
+    ] {
+        assert_eq!(chart.matches(mark).count(), SIZES, "{mark}: {chart}");
+    }
+    // Every row's letter is drawn: the denoised rows (1 and 4 spp) per size at least.
+    let plot_lines: Vec<&str> = chart.lines().filter(|l| l.contains('│')).collect();
+    let ds: usize = plot_lines.iter().map(|l| l.matches('D').count()).sum();
+    assert!(ds >= SIZES, "{chart}");
+    assert!(
+        plot_lines.iter().all(|l| l.chars().count() <= 80),
+        "{chart}"
+    );
+}
+
+#[test]
 fn csv_has_a_header_and_one_line_per_row() {
     let dir = TempDir::new("csv");
     let out = bench(&dir.0, &["--csv"]);

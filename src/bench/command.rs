@@ -40,6 +40,8 @@ pub struct BenchRequest {
     pub ref_bounces: Option<u32>,
     /// Print CSV instead of the Markdown table.
     pub csv: bool,
+    /// Draw the error-against-time chart in the terminal after the table.
+    pub plot: bool,
     /// Write the error-against-time plot here.
     pub svg: Option<PathBuf>,
     /// Rewrite the table between the bench markers of this README.
@@ -147,6 +149,11 @@ pub fn run_command(
         out.write_all(table.as_bytes())
     }
     .map_err(io_error("stdout"))?;
+    if request.plot {
+        writeln!(out)
+            .and_then(|()| out.write_all(super::plot::plot(&report).as_bytes()))
+            .map_err(io_error("stdout"))?;
+    }
     if let Some(path) = &request.svg {
         std::fs::write(path, svg(&report))
             .map_err(io_error(format!("cannot write {}", path.display())))?;

@@ -8,6 +8,7 @@
 pub mod command;
 pub mod metrics;
 pub mod output;
+pub mod plot;
 pub mod progress;
 pub mod reference;
 pub mod scene;

@@ -479,7 +479,7 @@ pub fn series<'a>(rows: &[&'a Row]) -> Vec<(String, &'static str, Vec<&'a Row>)>
 }
 
 /// A decade's label: 10^k written out for small k, else as 1e±k.
-fn tick(k: i32) -> String {
+pub(super) fn tick(k: i32) -> String {
     match k {
         0..=5 => format!("{}", 10u64.pow(k as u32)),
         -3..=-1 => format!("{}", 10f64.powi(k)),

@@ -92,6 +92,9 @@ pub(super) struct BenchArgs {
     /// Print CSV instead of the Markdown table.
     #[arg(long, conflicts_with = "scene")]
     pub(super) csv: bool,
+    /// Draw the error-against-time chart (log axes) in the terminal, after the table.
+    #[arg(long, conflicts_with = "scene")]
+    pub(super) plot: bool,
     /// Write the error-against-time plot (log axes) to PATH as SVG.
     #[arg(long, value_name = "PATH", conflicts_with = "scene")]
     pub(super) svg: Option<PathBuf>,

@@ -51,6 +51,7 @@ pub(super) fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
         ref_spp: a.ref_spp,
         ref_bounces: a.ref_bounces,
         csv: a.csv,
+        plot: a.plot,
         svg: a.svg,
         readme: a.readme,
         command: std::iter::once("raytty".to_string())
