@@ -9,6 +9,9 @@ use raytty::{HitCache, Stage, cornell_box, render_guided};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if args.get(1).map(String::as_str) == Some("light") {
+        return light_move();
+    }
     let w: u32 = args.get(1).map_or(200, |s| s.parse().unwrap());
     let h: u32 = args.get(2).map_or(100, |s| s.parse().unwrap());
     let path = args.get(3).cloned().unwrap_or_else(|| {
@@ -61,6 +64,73 @@ fn main() {
             d.image
                 .write_png(std::fs::File::create(format!("/tmp/den{spp}.png")).unwrap())
                 .unwrap();
+        }
+    }
+}
+
+/// A light held down for `steps` key presses (0.1 each) after 16 passes: the last frame's
+/// RMSE against 256 raw passes at the final light, starting fresh each step or keeping
+/// `history` samples of the indirect light.
+fn light_move() {
+    use raytty::PointLight;
+    let scene = cornell_box();
+    let (w, h) = (200, 100);
+    let gi = |frame| {
+        let mut s = Stage::Gi.settings(scene.effects());
+        s.frame = frame;
+        s
+    };
+    let guides = |lights: &[PointLight], frame| {
+        render_guided(
+            &scene,
+            &scene.camera(),
+            lights,
+            &gi(frame),
+            w,
+            h,
+            &mut HitCache::new(),
+        )
+        .guides
+        .unwrap()
+    };
+    for steps in [1u32, 4] {
+        let mut lights = scene.lights().to_vec();
+        let mut history = guides(&lights, 0);
+        for f in 1..16 {
+            history.accumulate(&guides(&lights, f), u32::MAX);
+        }
+        let mut runs: Vec<(u32, raytty::denoise::Guides)> = [0u32, 1, 2, 4, 8, 16]
+            .iter()
+            .map(|&k| (k, history.clone()))
+            .collect();
+        for step in 0..steps {
+            lights[0].position.x += 0.1;
+            let new = guides(&lights, 100 + step);
+            for (k, g) in &mut runs {
+                if *k == 0 {
+                    *g = new.clone();
+                } else {
+                    g.accumulate(&new, *k);
+                }
+            }
+        }
+        let mut sum = vec![glam::DVec3::ZERO; (w * h) as usize];
+        for f in 0..256 {
+            let img = raytty::render(&scene, &scene.camera(), &lights, &gi(1000 + f), w, h).image;
+            for (s, p) in sum.iter_mut().zip(&img.pixels) {
+                *s += p.as_dvec3();
+            }
+        }
+        let reference = raytty::Image {
+            width: w,
+            height: h,
+            pixels: sum.iter().map(|s| (*s / 256.0).as_vec3()).collect(),
+        };
+        for (k, g) in &runs {
+            println!(
+                "{steps} step(s), history {k:>2}: denoised RMSE {:.4}",
+                rmse(&denoise(g).image, &reference)
+            );
         }
     }
 }

@@ -44,6 +44,11 @@ const PLANE_COS: f32 = 0.1;
 /// neighbour's weight (roughly; SVGF's σ_l = 4).
 const SIGMA_LUMINANCE: f32 = 4.0;
 
+/// A pixel's irradiance is clamped to this many standard deviations (of a pixel's mean) above
+/// its neighbourhood's mean luminance. As samples accumulate the deviation of a mean shrinks
+/// and so does what lies beyond it: the clamp fades with the noise.
+const FIREFLY_SIGMAS: f32 = 3.0;
+
 /// Albedo channels below this are not demodulated (a division by almost nothing would blow
 /// the noise up); such a channel keeps its raw indirect light.
 const MIN_ALBEDO: f32 = 1e-3;
@@ -128,9 +133,23 @@ pub fn denoise(g: &Guides) -> Denoised {
             })
             .collect(),
     };
-    let mut e: Vec<Vec3> = g.pixels.iter().map(demodulate).collect();
-    let mut var = spatial_variance(g, &surface);
+    let moments = spatial_variance(g, &surface);
+    let mut var: Vec<f32> = moments.iter().map(|m| m.0).collect();
     let raw_error = error_estimate(g, &var);
+    // Outliers (a bounce that found the light from close by) are pulled down to
+    // FIREFLY_SIGMAS standard deviations above their surface's mean before filtering: a
+    // filter that stops at luminance edges would otherwise keep them as bright dots.
+    let mut e: Vec<Vec3> = g
+        .pixels
+        .iter()
+        .zip(&moments)
+        .map(|(p, &(v, mean))| {
+            let e = demodulate(p);
+            let cap = mean + FIREFLY_SIGMAS * v.sqrt();
+            let l = luminance(e);
+            if l > cap && l > 0.0 { e * (cap / l) } else { e }
+        })
+        .collect();
     if n > 0 {
         let mut e_next = vec![Vec3::ZERO; n];
         let mut var_next = vec![0.0; n];
@@ -214,10 +233,10 @@ fn geometric_weight(s: &Surface, p: usize, q: usize) -> f32 {
 
 /// The per-pixel variance of the mean irradiance's luminance, estimated from the moments of
 /// the neighbours on the same surface (one sample per pixel has no variance of its own):
-/// `(E[l²] − E[l]²) / samples`.
-fn spatial_variance(g: &Guides, s: &Surface) -> Vec<f32> {
+/// `(E[l²] − E[l]²) / samples`; and the neighbours' mean luminance `E[l]`.
+fn spatial_variance(g: &Guides, s: &Surface) -> Vec<(f32, f32)> {
     let (w, h) = (g.width as usize, g.height as usize);
-    let mut out = vec![0.0; w * h];
+    let mut out = vec![(0.0, 0.0); w * h];
     let samples = g.samples.max(1) as f32;
     out.par_chunks_mut(w.max(1))
         .enumerate()
@@ -244,7 +263,7 @@ fn spatial_variance(g: &Guides, s: &Surface) -> Vec<f32> {
                     }
                 }
                 let (m1, m2) = (m1 / sum, m2 / sum);
-                *v = (m2 - m1 * m1).max(0.0) / samples;
+                *v = ((m2 - m1 * m1).max(0.0) / samples, m1);
             }
         });
     out
