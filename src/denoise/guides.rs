@@ -108,3 +108,39 @@ impl Guides {
 pub fn luminance(c: Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn guides(v: f32, samples: u32) -> Guides {
+        let p = GuidePixel {
+            rest: Vec3::splat(v),
+            albedo: Vec3::ONE,
+            indirect: Vec3::splat(v),
+            moments: [v, v * v],
+            guide: None,
+        };
+        Guides {
+            width: 1,
+            height: 1,
+            samples,
+            pixels: vec![p],
+        }
+    }
+
+    #[test]
+    fn accumulation_weighs_by_samples_and_a_cap_bounds_the_history() {
+        let mut g = guides(1.0, 3);
+        g.accumulate(&guides(5.0, 1), u32::MAX);
+        assert_eq!(g.samples, 4);
+        assert_eq!(g.pixels[0].indirect, Vec3::splat(2.0));
+        assert_eq!(g.raw(), [Vec3::splat(4.0)]);
+        // Capped at 1: old and new weigh the same; the exact part is the new frame's.
+        let mut g = guides(1.0, 100);
+        g.accumulate(&guides(3.0, 1), 1);
+        assert_eq!(g.samples, 2);
+        assert_eq!(g.pixels[0].indirect, Vec3::splat(2.0));
+        assert_eq!(g.pixels[0].rest, Vec3::splat(3.0));
+    }
+}
