@@ -40,6 +40,11 @@ fn main() {
     s.effects.samples = ref_spp;
     s.frame = 0x2000_0000;
     let reference = render(&scene, &scene.camera(), scene.lights(), &s, W, H).image;
+    println!(
+        "{name}: RMSE against the reference: raw {:.4}, denoised {:.4}",
+        raytty::bench::metrics::rmse(&raw, &reference),
+        raytty::bench::metrics::rmse(&denoised, &reference)
+    );
     let mut sheet = Image {
         width: 3 * W + 2 * GAP,
         height: H,
