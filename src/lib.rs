@@ -31,6 +31,8 @@ pub mod scene;
 pub mod scene_bench;
 pub mod scenefile;
 pub mod shading;
+pub mod tri4;
+pub mod flat4;
 
 pub use accel::{AccelKind, AccelStats, Hit};
 pub use camera::Camera;
