@@ -8,9 +8,9 @@
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use raytty::cornell::colours;
-use raytty::procedural::displaced_icosphere;
-use raytty::scene_bench::bench_scene;
+use raytty::bench::scene::bench_scene;
+use raytty::scene::cornell::colours;
+use raytty::scene::procedural::displaced_icosphere;
 use raytty::{AccelKind, Camera, Effects, Material, Scene, SceneBuilder, cornell_box};
 
 /// Timed runs per size.
@@ -110,7 +110,7 @@ fn sphere_scene(k: u32) -> (Scene, Duration, Duration, Option<Duration>) {
     let gold = b.material(Material::diffuse(Vec3::new(0.75, 0.6, 0.2)));
     let offset = Vec3::new(0.0, 0.3, 0.1);
     b.object(mesh.into_iter().map(|t| t.map(|p| p * 0.6 + offset)), gold);
-    b.light(raytty::cornell::LIGHT);
+    b.light(raytty::scene::cornell::LIGHT);
     let (start, cpu) = (Instant::now(), cpu_time());
     let scene = b
         .build("sphere", Camera::default(), Effects::SEED)

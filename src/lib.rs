@@ -16,30 +16,23 @@
 
 pub mod accel;
 pub mod bench;
-pub mod builtin;
-pub mod bvh;
 pub mod camera;
-pub mod cornell;
 pub mod frame;
 pub mod geometry;
 pub mod image;
-pub mod obj;
-pub mod procedural;
 pub mod render;
 pub mod rng;
 pub mod scene;
-pub mod scene_bench;
-pub mod scenefile;
 pub mod shading;
 pub mod tri4;
 pub mod flat4;
 
 pub use accel::{AccelKind, AccelStats, Hit};
 pub use camera::Camera;
-pub use cornell::cornell_box;
 pub use frame::{CellGrid, ColorMode, encode_diff, encode_text, printable};
 pub use geometry::{Ray, Triangle};
 pub use image::Image;
 pub use render::{Frame, FrameStats, HitCache, render, render_cached};
+pub use scene::cornell::cornell_box;
 pub use scene::{Effects, Indirect, Material, PointLight, Scene, SceneBuilder};
 pub use shading::{Mode, RayCounts, Settings, Stage, Tracer};

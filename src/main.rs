@@ -1,7 +1,6 @@
 //! The `raytty` command: the interactive app, `render`, and the tools around them.
 
 mod cli;
-mod scene_arg;
 #[cfg(feature = "tui")]
 mod tui;
 

@@ -7,10 +7,10 @@
 
 use glam::Vec3;
 use raytty::accel::BVH_THRESHOLD;
-use raytty::bvh::{Bvh, MAX_DEPTH};
+use raytty::accel::bvh::{Bvh, MAX_DEPTH};
 use raytty::geometry::intersect_watertight;
-use raytty::procedural::displaced_icosphere;
 use raytty::rng::Rng;
+use raytty::scene::procedural::displaced_icosphere;
 use raytty::{
     AccelKind, Camera, Effects, Hit, Material, PointLight, Ray, Scene, SceneBuilder, Stage,
     Triangle, cornell_box, render,
@@ -336,7 +336,7 @@ fn leaves_hold_a_few_triangles() {
     let bvh = Bvh::build(&tris);
     let per_leaf = tris.len() as f64 / bvh.leaves() as f64;
     assert!(
-        (1.0..=raytty::bvh::LEAF_MAX as f64).contains(&per_leaf),
+        (1.0..=raytty::accel::bvh::LEAF_MAX as f64).contains(&per_leaf),
         "{per_leaf} triangles per leaf"
     );
     // A binary tree: one more leaf than interior nodes.

@@ -18,9 +18,9 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use raytty::builtin::BUILTINS;
 use raytty::rng::Rng;
-use raytty::scenefile::{self, SceneFileError};
+use raytty::scene::builtin::BUILTINS;
+use raytty::scene::file::{self, SceneFileError};
 use raytty::{Stage, render};
 
 /// Largest mutated input: far above the seed files, small enough that every input is quick.
@@ -180,7 +180,7 @@ fn check(scene: &str, mesh: &[u8], tally: &mut Tally) {
         }
     };
     let outcome = catch_unwind(AssertUnwindSafe(|| {
-        let result = scenefile::parse(scene, "fuzz.toml", "fuzz", &read);
+        let result = file::parse(scene, "fuzz.toml", "fuzz", &read);
         if let Ok(s) = &result {
             // A scene that loaded renders a finite frame (samples capped to keep it quick).
             let mut settings = Stage::Indirect.settings(s.effects);
@@ -247,7 +247,7 @@ fn run(iterations: u64, seed: u64) -> Tally {
 fn every_seed_loads() {
     for (i, s) in seeds().iter().enumerate() {
         let read = |_: &str| Ok((MESH.to_string(), MESH_SEED.as_bytes().to_vec()));
-        scenefile::parse(s, "seed.toml", "seed", &read).unwrap_or_else(|e| panic!("seed {i}: {e}"));
+        file::parse(s, "seed.toml", "seed", &read).unwrap_or_else(|e| panic!("seed {i}: {e}"));
     }
 }
 
@@ -260,7 +260,7 @@ fn regression_corpus() {
         if path.extension().is_some_and(|e| e == "toml") {
             n += 1;
             let source = String::from_utf8_lossy(&std::fs::read(&path).unwrap()).into_owned();
-            let outcome = catch_unwind(|| scenefile::load(&path));
+            let outcome = catch_unwind(|| file::load(&path));
             let must_load = path
                 .file_name()
                 .unwrap()
@@ -418,7 +418,7 @@ fn run_generated(n: u64, seed: u64) -> (u64, u64) {
     let (mut loaded, mut refused) = (0, 0);
     for _ in 0..n {
         let (text, ok) = generated(&mut rng);
-        match scenefile::parse(&text, "gen.toml", "gen", &scenefile::no_meshes) {
+        match file::parse(&text, "gen.toml", "gen", &file::no_meshes) {
             Ok(_) if ok => loaded += 1,
             Err(e) if !ok => {
                 positioned(&e, &text);

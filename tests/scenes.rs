@@ -1,8 +1,8 @@
 //! The built-in scenes and scene files, seen through what a frame costs: each scene calls for
 //! different effects, and the frame stats show only those being simulated.
 
-use raytty::builtin::{self, BUILTINS};
-use raytty::scenefile;
+use raytty::scene::builtin::{self, BUILTINS};
+use raytty::scene::file;
 use raytty::{FrameStats, Scene, Stage, render};
 
 fn load(name: &str) -> Scene {
@@ -68,7 +68,7 @@ fn the_lights_scene_traces_shadow_rays_per_light() {
 #[test]
 fn the_example_file_loads_with_every_kind_of_object() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/example.toml");
-    let scene = scenefile::load(std::path::Path::new(path)).unwrap();
+    let scene = file::load(std::path::Path::new(path)).unwrap();
     // Two floor triangles, two boxes, the tetrahedron, and a k = 8 icosphere.
     assert_eq!(scene.triangles.len(), 2 + 12 + 12 + 4 + 20 * 64);
     assert_eq!(scene.name, "example");
@@ -80,11 +80,11 @@ fn the_example_file_loads_with_every_kind_of_object() {
 
 #[test]
 fn transforms_scale_then_rotate_then_translate() {
-    let scene = scenefile::parse(
+    let scene = file::parse(
         "[material.m]\ncolour = [0.5, 0.5, 0.5]\n[[object]]\nkind = \"box\"\nmaterial = \"m\"\nmin = [0, 0, 0]\nmax = [1, 1, 2]\nscale = 2\nrotate_y = 90\ntranslate = [10, 0, 0]\n",
         "t.toml",
         "t",
-        &scenefile::no_meshes,
+        &file::no_meshes,
     )
     .unwrap();
     let (mut lo, mut hi) = (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN));
@@ -101,11 +101,11 @@ fn transforms_scale_then_rotate_then_translate() {
 
 #[test]
 fn the_scene_name_comes_from_the_file_and_keeps_its_characters() {
-    let scene = scenefile::parse(
+    let scene = file::parse(
         "name = \"box\\u001b[2J\"\n[material.m]\ncolour = [1, 1, 1]\n[[object]]\nkind = \"box\"\nmaterial = \"m\"\ncentre = [0, 0, 0]\nsize = [1, 1, 1]\n",
         "n.toml",
         "n",
-        &scenefile::no_meshes,
+        &file::no_meshes,
     )
     .unwrap();
     // The scene keeps the name as written; the app shows it through `printable`.

@@ -8,7 +8,8 @@ mod common;
 
 use common::{Rng, unit};
 use glam::Vec3;
-use raytty::{Camera, Effects, Material, Ray, Scene, SceneBuilder, cornell_box, procedural};
+use raytty::scene::procedural;
+use raytty::{Camera, Effects, Material, Ray, Scene, SceneBuilder, cornell_box};
 
 /// Random rays per mesh in the random-ray test (the issue asks for 100 000 on the sphere).
 const RANDOM_RAYS: u32 = 100_000;

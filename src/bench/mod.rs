@@ -9,6 +9,7 @@ pub mod command;
 pub mod metrics;
 pub mod output;
 pub mod reference;
+pub mod scene;
 
 use std::io;
 use std::path::PathBuf;
@@ -331,7 +332,7 @@ fn measure(
     }
     times.sort();
     let ms = |d: Duration| d.as_secs_f64() * 1e3;
-    let median_ms = ms(crate::scene_bench::median(&times));
+    let median_ms = ms(crate::bench::scene::median(&times));
     let rays = frame.stats.rays;
     Row {
         width,

@@ -343,7 +343,7 @@ mod tests {
     /// (up to the rounding of mean·n), and a second call reads it from the cache.
     #[test]
     fn more_samples_resume_from_fewer_and_are_cached() {
-        let scene = crate::cornell::cornell_box();
+        let scene = crate::scene::cornell::cornell_box();
         let tmp = std::env::temp_dir().join(format!("raytty-ref-test-{}", std::process::id()));
         let (a, b) = (tmp.join("a"), tmp.join("b"));
         let spec = |spp| ReferenceSpec::new(&scene, 12, 10, spp, 4);

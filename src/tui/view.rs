@@ -420,7 +420,8 @@ mod tests {
     fn the_status_line_starts_with_the_scene_name_without_control_characters() {
         let source = "name = \"evil\\u001b[2J\\u0007box\"\n[material.m]\ncolour = [1, 1, 1]\n[[object]]\nkind = \"box\"\nmaterial = \"m\"\ncentre = [0, 0, 0]\nsize = [1, 1, 1]\n";
         let scene =
-            raytty::scenefile::parse(source, "t.toml", "t", &raytty::scenefile::no_meshes).unwrap();
+            raytty::scene::file::parse(source, "t.toml", "t", &raytty::scene::file::no_meshes)
+                .unwrap();
         let a = App::new(scene, ColorMode::Ascii, (40, 5));
         let mut s = Screen::new();
         assert!(

@@ -5,29 +5,25 @@
 //! - [`AccelKind::Flat`]: the scene's objects (the Cornell room, each block, a mesh), each with
 //!   a bounding box; a ray is tested against the triangles of every object whose box it meets.
 //!   Fastest for a few dozen triangles.
-//! - [`AccelKind::Bvh`]: a bounding volume hierarchy ([`crate::bvh`]).
+//! - [`AccelKind::Bvh`]: a bounding volume hierarchy ([`crate::accel::bvh`]).
 //!
 //! Both answer exactly as testing every triangle would: the closest hit is the one with the
 //! smallest `t`, ties going to the lowest triangle index, and a shadow ray is occluded when any
 //! triangle has a hit before `t_max`. So a frame is byte-identical whichever is used (see
-//! [`crate::bvh`] for how culling keeps to that).
+//! [`crate::accel::bvh`] for how culling keeps to that).
+
+pub mod bvh;
+mod flat;
+mod hit;
 
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
-use crate::bvh::{Bvh, cull_bound, shrunk_t_max};
-use crate::geometry::{Aabb, Ray, Triangle, intersect_watertight};
+use crate::geometry::{Aabb, Ray, Triangle};
+use bvh::Bvh;
+use flat::{flat_intersect, flat_occluded};
 
-/// A closest hit in a scene.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hit {
-    /// Ray parameter of the hit (`> 0`).
-    pub t: f32,
-    /// Barycentric weights of the triangle's three vertices.
-    pub b: [f32; 3],
-    /// Index of the triangle in [`crate::Scene::triangles`].
-    pub triangle: u32,
-}
+pub use hit::{CULL_SLACK, Hit, cull_bound, shrunk_t_max};
 
 /// Scenes with at least this many triangles get a BVH; smaller ones the flat object list.
 ///
@@ -183,50 +179,4 @@ impl Accel {
             Structure::Bvh(bvh) => bvh.occluded(ray, t_max),
         }
     }
-}
-
-fn flat_intersect(
-    objects: &[(Aabb, Range<usize>)],
-    triangles: &[Triangle],
-    ray: &Ray,
-    t_max: f32,
-) -> Option<Hit> {
-    let mut best: Option<Hit> = None;
-    let mut tri_t_max = t_max;
-    let mut bound = cull_bound(t_max);
-    for (aabb, range) in objects {
-        if !aabb.hit(ray, bound) {
-            continue;
-        }
-        for i in range.clone() {
-            let Some(h) = intersect_watertight(ray, &triangles[i].v, tri_t_max) else {
-                continue;
-            };
-            if best.is_none_or(|b| h.t < b.t || h.t == b.t && (i as u32) < b.triangle) {
-                best = Some(Hit {
-                    t: h.t,
-                    b: h.b,
-                    triangle: i as u32,
-                });
-                tri_t_max = shrunk_t_max(h.t, t_max);
-                bound = cull_bound(h.t);
-            }
-        }
-    }
-    best
-}
-
-fn flat_occluded(
-    objects: &[(Aabb, Range<usize>)],
-    triangles: &[Triangle],
-    ray: &Ray,
-    t_max: f32,
-) -> bool {
-    let bound = cull_bound(t_max);
-    objects.iter().any(|(aabb, range)| {
-        aabb.hit(ray, bound)
-            && triangles[range.clone()]
-                .iter()
-                .any(|t| intersect_watertight(ray, &t.v, t_max).is_some())
-    })
 }

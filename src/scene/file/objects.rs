@@ -10,8 +10,8 @@ use super::error::{SceneFileError, did_you_mean};
 use super::spec::{NumberOrTriple, ObjectSpec};
 use super::*;
 use crate::geometry::Triangle;
-use crate::obj::parse_obj;
-use crate::procedural::{displaced_icosphere, icosphere_triangles};
+use crate::scene::obj::parse_obj;
+use crate::scene::procedural::{displaced_icosphere, icosphere_triangles};
 
 /// The object kinds and the keys each one takes besides `kind`, `material` and the transform.
 const KINDS: [(&str, &[&str]); 4] = [

@@ -2,6 +2,12 @@
 //! for. A scene that was built is valid: every triangle has a finite unit normal, every light a
 //! finite position and non-negative power, so rendering it cannot fail.
 
+pub mod builtin;
+pub mod cornell;
+pub mod file;
+pub mod obj;
+pub mod procedural;
+
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 

@@ -2,7 +2,7 @@
 //! different effects.
 
 use crate::scene::Scene;
-use crate::scenefile::{self, SceneFileError};
+use crate::scene::file::{self, SceneFileError};
 
 /// A scene that ships with raytty.
 #[derive(Clone, Copy, Debug)]
@@ -23,25 +23,25 @@ pub const BUILTINS: [Builtin; 4] = [
         name: "cornell",
         description: "the seed's Cornell box: one light, no mirrors (the default)",
         triangles: 30,
-        source: include_str!("../scenes/cornell.toml"),
+        source: include_str!("../../scenes/cornell.toml"),
     },
     Builtin {
         name: "mirror",
         description: "the Cornell box with a mirror for its tall block: reflection rays",
         triangles: 30,
-        source: include_str!("../scenes/mirror.toml"),
+        source: include_str!("../../scenes/mirror.toml"),
     },
     Builtin {
         name: "lights",
         description: "a white Cornell box lit by red, green and blue lights: a shadow ray per light",
         triangles: 30,
-        source: include_str!("../scenes/lights.toml"),
+        source: include_str!("../../scenes/lights.toml"),
     },
     Builtin {
         name: "sphere",
         description: "a displaced icosphere of 1,003,520 triangles in the Cornell room",
         triangles: 1_003_530,
-        source: include_str!("../scenes/sphere.toml"),
+        source: include_str!("../../scenes/sphere.toml"),
     },
 ];
 
@@ -58,11 +58,11 @@ pub fn names() -> Vec<&'static str> {
 impl Builtin {
     /// Builds the scene (the large ones generate their meshes here).
     pub fn load(&self) -> Result<Scene, SceneFileError> {
-        scenefile::parse(
+        file::parse(
             self.source,
             &format!("{}.toml (built in)", self.name),
             self.name,
-            &scenefile::no_meshes,
+            &file::no_meshes,
         )
     }
 }

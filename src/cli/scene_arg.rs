@@ -4,8 +4,9 @@
 use std::path::Path;
 
 use anyhow::{Result, bail};
-use raytty::builtin::{self, BUILTINS};
-use raytty::{Scene, printable, scenefile};
+use raytty::scene::builtin::{self, BUILTINS};
+use raytty::scene::file;
+use raytty::{Scene, printable};
 
 use crate::cli::UsageError;
 
@@ -42,14 +43,14 @@ pub fn load_scene(arg: Option<&str>) -> Result<Scene> {
         )));
     }
     if path.exists() {
-        return scenefile::load(path).map_err(|e| UsageError(e.to_string()).into());
+        return file::load(path).map_err(|e| UsageError(e.to_string()).into());
     }
     match builtin::find(arg) {
         Some(b) => b.load().map_err(|e| UsageError(e.to_string()).into()),
         None => bail!(UsageError(format!(
             "--scene {}: no such file and no built-in scene of that name{} (built-in scenes: {}; or give the path of a .toml scene file)",
             printable(arg),
-            scenefile::did_you_mean(arg, &builtin::names()),
+            file::did_you_mean(arg, &builtin::names()),
             builtins()
         ))),
     }

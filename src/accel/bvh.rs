@@ -13,11 +13,11 @@
 //! as [`intersect_watertight`] computes it for the query's `t_max`. [`Bvh::occluded`] is true
 //! exactly when one triangle has such a hit. Only two things could make a traversal differ:
 //!
-//! - A box is skipped only when the ray reaches it beyond [`cull_bound`] of the best hit so
+//! - A box is skipped only when the ray reaches it beyond [`cull_bound`](super::cull_bound) of the best hit so
 //!   far: a triangle's computed `t` may fall a little short of the box around it, so the bound
-//!   is widened by [`CULL_SLACK`].
+//!   is widened by [`CULL_SLACK`](super::CULL_SLACK).
 //! - A triangle is tested with `t_max` shrunk to the best hit so far, widened by a few ULPs
-//!   ([`shrunk_t_max`]), so a hit that ties the best one is still reported and the tie is
+//!   ([`shrunk_t_max`](super::shrunk_t_max)), so a hit that ties the best one is still reported and the tie is
 //!   broken by index.
 
 mod build;
@@ -25,37 +25,14 @@ mod build;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::accel::Hit;
-use crate::geometry::{Ray, Triangle, gamma, intersect_watertight, next_float_up};
+use super::hit::{Hit, cull_bound, shrunk_t_max};
+use crate::geometry::{Ray, Triangle, gamma, intersect_watertight};
 
 pub use build::{LEAF_MAX, SAH_BINS};
 
 /// Most levels a hierarchy has (root = level 1); the builder keeps to it by switching from SAH to
 /// median splits deep down, so traversal can use a fixed stack.
 pub const MAX_DEPTH: usize = 64;
-
-/// A box is culled only if the ray enters it beyond the best hit's `t` times `1 + CULL_SLACK`.
-///
-/// The true hit point lies inside the triangle's box, but the watertight test's `t` carries
-/// rounding error, largest for rays grazing the triangle's plane: about `u·size/θ` relative for a
-/// ray at angle θ to it (u = 2⁻²⁴). 2⁻¹⁰ covers angles down to about 6e-5 rad, and costs almost
-/// nothing: a box entered beyond the best hit but within a thousandth of its distance is rare.
-pub const CULL_SLACK: f32 = 1.0 / 1024.0;
-
-/// The `t` beyond which a box can hold no hit that beats `best` (or, with no hit yet, `t_max`).
-#[inline]
-pub fn cull_bound(bound: f32) -> f32 {
-    bound * (1.0 + CULL_SLACK)
-}
-
-/// The `t_max` a triangle is tested with once a hit at `best` is known: four ULPs above it (the
-/// test's own `t_max` comparisons round `t·det` and `1/det`, at most three ULPs between them), so
-/// that a hit tying `best` is still reported; never above the query's `t_max`.
-#[inline]
-pub fn shrunk_t_max(best: f32, t_max: f32) -> f32 {
-    let up = next_float_up(next_float_up(next_float_up(next_float_up(best))));
-    if up < t_max { up } else { t_max }
-}
 
 /// The far side of a slab is widened by this factor (pbrt-v4's 1 + 2γ₃), so that rounding in
 /// the two slab distances never culls a box the ray grazes.

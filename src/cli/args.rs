@@ -1,0 +1,206 @@
+//! The command line as clap types, and the parsers of its values.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use glam::Vec3;
+use raytty::{ColorMode, Stage};
+
+/// Renders the Cornell box (or another scene) by ray tracing, in the terminal.
+///
+/// With no command on a terminal, raytty runs the interactive app; when stdout is not a
+/// terminal (or TERM is dumb) it prints one frame, as `raytty render` would. Frames are truecolor half-blocks:
+/// each cell shows two pixels, so an 80×24 frame is 80×48 pixels.
+#[derive(Parser, Debug)]
+#[command(name = "raytty", version, about, long_about)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub(super) command: Option<Command>,
+    /// Colours of the app and of the frame printed with no command: auto (ascii if NO_COLOR is
+    /// set, truecolor if COLORTERM is truecolor or 24bit, else 256), truecolor, 256 or ascii.
+    /// ssh does not forward COLORTERM: pass --color truecolor (or press C) to get it back.
+    #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+    pub(super) color: ColorChoice,
+    /// The scene: a scene file (a path that exists or ends in .toml) or a built-in scene's name
+    /// (`raytty scenes` lists them). Default: the Cornell box.
+    #[arg(long, global = true, value_name = "PATH|NAME")]
+    pub(super) scene: Option<String>,
+}
+
+/// The `--color` choices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(super) enum ColorChoice {
+    /// Decide from NO_COLOR and COLORTERM.
+    Auto,
+    /// 24-bit colour.
+    Truecolor,
+    /// The xterm 256-colour palette.
+    #[value(name = "256")]
+    Ansi256,
+    /// No colour escapes at all.
+    Ascii,
+}
+
+/// The colour mode for `choice`, given whether NO_COLOR is set (and not empty) and COLORTERM.
+pub(super) fn resolve_color(
+    choice: ColorChoice,
+    no_color: bool,
+    colorterm: Option<&str>,
+) -> ColorMode {
+    match choice {
+        ColorChoice::Truecolor => ColorMode::TrueColor,
+        ColorChoice::Ansi256 => ColorMode::Ansi256,
+        ColorChoice::Ascii => ColorMode::Ascii,
+        ColorChoice::Auto if no_color => ColorMode::Ascii,
+        ColorChoice::Auto if matches!(colorterm, Some("truecolor" | "24bit")) => {
+            ColorMode::TrueColor
+        }
+        ColorChoice::Auto => ColorMode::Ansi256,
+    }
+}
+
+#[derive(Subcommand, Debug)]
+pub(super) enum Command {
+    /// Render one frame to stdout or a file (text frames or images).
+    Render(RenderArgs),
+    /// Measure what each step of accuracy costs: time per frame against error from a cached
+    /// path-traced reference (a Markdown table, or CSV; an SVG plot; the README's table).
+    Bench(BenchArgs),
+    /// List the built-in scenes with their triangle counts.
+    Scenes,
+}
+
+/// Options of `raytty bench`.
+#[derive(Args, Debug)]
+pub(super) struct BenchArgs {
+    /// Image sizes in pixels, comma-separated (default 500x500,200x100).
+    #[arg(long, value_name = "WxH,...", value_parser = parse_size, value_delimiter = ',')]
+    pub(super) sizes: Vec<(u32, u32)>,
+    /// Timed runs per row, after a warm-up (default 5).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub(super) runs: Option<u32>,
+    /// GI rows go 1, 4, 16, … samples per pixel up to this (default 64).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub(super) max_spp: Option<u32>,
+    /// The reference's samples per pixel (default 1024).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    pub(super) ref_spp: Option<u32>,
+    /// The reference's maximum bounces (default 16).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(super) ref_bounces: Option<u32>,
+    /// Print CSV instead of the Markdown table.
+    #[arg(long)]
+    pub(super) csv: bool,
+    /// Write the error-against-time plot (log axes) to PATH as SVG.
+    #[arg(long, value_name = "PATH")]
+    pub(super) svg: Option<PathBuf>,
+    /// Rewrite the table between <!-- bench:start --> and <!-- bench:end --> in PATH.
+    #[arg(long, value_name = "PATH")]
+    pub(super) readme: Option<PathBuf>,
+    /// Tiny sizes, 2 runs, a small reference: seconds, for tests.
+    #[arg(long)]
+    pub(super) quick: bool,
+}
+
+/// Output formats of `raytty render`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(super) enum Format {
+    /// Truecolor half-blocks (24-bit SGR).
+    Ansi,
+    /// xterm 256-colour half-blocks.
+    Ansi256,
+    /// Plain ASCII luminance ramp, no escapes.
+    Ascii,
+    /// 8-bit PNG image (clamped linear values, no gamma).
+    Png,
+    /// Linear float PFM image.
+    Pfm,
+}
+
+/// Options of `raytty render`.
+#[derive(Args, Debug)]
+pub(super) struct RenderArgs {
+    /// Frame size in terminal cells, COLSxROWS: COLS × 2·ROWS pixels (default 80x24 for text;
+    /// images default to 500x500 pixels unless --size or --pixels is given).
+    #[arg(long, value_name = "COLSxROWS", value_parser = parse_size)]
+    pub(super) size: Option<(u32, u32)>,
+    /// Image size in pixels, WxH (default 500x500 for png and pfm; overrides --size).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub(super) pixels: Option<(u32, u32)>,
+    /// Output format (default: from the -o file's extension, .png or .pfm; else ansi, or
+    /// ascii if NO_COLOR is set).
+    #[arg(long, value_enum)]
+    pub(super) format: Option<Format>,
+    /// Shading stage: flat, light, direct, shadows, indirect (the default) or gi.
+    #[arg(long, value_parser = parse_stage, default_value = "indirect")]
+    pub(super) stage: Stage,
+    /// Samples per pixel, 1 to 1024, spread over the pixel: smooth edges, and far less noise
+    /// in the gi stage (one sample is noisy). Default: the scene's (1 for gi).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(super) samples: Option<u32>,
+    /// Camera position and yaw in degrees, x,y,z,yaw (default: the scene's camera).
+    #[arg(long, value_name = "X,Y,Z,YAW", value_parser = parse_camera, allow_hyphen_values = true)]
+    pub(super) camera: Option<[f32; 4]>,
+    /// Light position x,y,z (default: the scene's first light).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(super) light: Option<Vec3>,
+    /// Write to FILE instead of stdout.
+    #[arg(short, long, value_name = "FILE")]
+    pub(super) output: Option<PathBuf>,
+}
+
+/// Most pixels `--pixels` may ask for: about 48 bytes each (float image, cached hits, 8-bit
+/// copy, encoder buffers), so 64 Mpixel stays near 3 GiB.
+pub(super) const MAX_PIXELS: u64 = 64 * 1024 * 1024;
+
+pub(super) fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let bad = || {
+        format!(
+            "'{s}' is not a size: expected WIDTHxHEIGHT with whole numbers from 1 to 65535, e.g. 80x24"
+        )
+    };
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let w: u32 = w.trim().parse().map_err(|_| bad())?;
+    let h: u32 = h.trim().parse().map_err(|_| bad())?;
+    if w == 0 || h == 0 || w > 65535 || h > 65535 {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
+pub(super) fn parse_stage(s: &str) -> Result<Stage, String> {
+    Stage::from_name(s).ok_or_else(|| {
+        let names: Vec<_> = Stage::ALL.iter().map(|s| s.name()).collect();
+        format!("'{s}' is not a stage: expected one of {}", names.join(", "))
+    })
+}
+
+pub(super) fn parse_floats<const N: usize>(s: &str, what: &str) -> Result<[f32; N], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != N {
+        return Err(format!(
+            "'{s}' is not {what}: expected {N} comma-separated numbers"
+        ));
+    }
+    let mut out = [0.0f32; N];
+    for (o, p) in out.iter_mut().zip(parts) {
+        *o = p
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{p}' in '{s}' is not a number"))?;
+        if !o.is_finite() || o.abs() > 1e6 {
+            return Err(format!(
+                "'{p}' in '{s}' is out of range: expected a finite number within ±1e6"
+            ));
+        }
+    }
+    Ok(out)
+}
+
+pub(super) fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    parse_floats::<3>(s, "a position x,y,z").map(Vec3::from)
+}
+
+pub(super) fn parse_camera(s: &str) -> Result<[f32; 4], String> {
+    parse_floats::<4>(s, "a camera x,y,z,yaw_degrees")
+}

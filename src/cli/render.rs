@@ -1,0 +1,159 @@
+//! `raytty render`: one frame to stdout or a file.
+
+use std::fs::File;
+use std::io::{self, BufWriter, IsTerminal, Write};
+
+use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
+use glam::Vec3;
+use raytty::{CellGrid, ColorMode, PointLight, Scene, encode_text, render};
+
+use super::UsageError;
+use super::args::*;
+
+/// `raytty render`; `no_color` (NO_COLOR is set) makes ascii the default text format.
+pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool) -> Result<()> {
+    if let Some(ext) = args.output.as_deref().and_then(unwritable_image_extension) {
+        bail!(UsageError(format!(
+            "-o {}: raytty cannot write .{ext} images: use a .png or .pfm file name (or --format ascii|ansi|ansi256 for text)",
+            args.output
+                .as_deref()
+                .unwrap_or_else(|| "".as_ref())
+                .display()
+        )));
+    }
+    let format = args
+        .format
+        .unwrap_or_else(|| match format_for(args.output.as_deref()) {
+            Format::Ansi if no_color => Format::Ascii,
+            f => f,
+        });
+    let image_format = matches!(format, Format::Png | Format::Pfm);
+    if image_format && args.output.is_none() && io::stdout().is_terminal() {
+        bail!(UsageError(format!(
+            "--format {} writes binary data: give -o FILE or redirect stdout",
+            format_name(format)
+        )));
+    }
+    let (w, h) = match (args.pixels, args.size, image_format) {
+        (Some(p), _, _) => p,
+        (None, Some((cols, rows)), _) => (cols, rows * 2),
+        (None, None, true) => (500, 500),
+        (None, None, false) => (80, 48),
+    };
+    let pixels = w as u64 * h as u64;
+    if pixels > MAX_PIXELS {
+        let asked = match args.pixels {
+            Some(_) => format!("--pixels {w}x{h} is"),
+            None => format!("--size {}x{} is {w}x{h} =", w, h / 2),
+        };
+        bail!(UsageError(format!(
+            "{asked} {pixels} pixels, about {} MiB of memory; the limit is {MAX_PIXELS} pixels (e.g. --pixels 8192x8192 or --size 8192x4096)",
+            pixels * 48 / (1024 * 1024)
+        )));
+    }
+    let scene = crate::cli::scene_arg::load_scene(scene)?;
+    let mut camera = scene.camera;
+    if let Some([x, y, z, yaw]) = args.camera {
+        camera.position = Vec3::new(x, y, z);
+        camera.yaw = yaw.to_radians();
+    }
+    if args.light.is_some() && scene.lights.is_empty() {
+        bail!(UsageError(
+            "--light moves the scene's first light, and this scene has none: add a [[light]] to the scene file".into()
+        ));
+    }
+    let lights = lights_with(&scene, args.light);
+    let mut settings = args.stage.settings(scene.effects);
+    if let Some(n) = args.samples {
+        settings.effects.samples = n;
+    }
+    // The output file is created before the (maybe long) render, so a bad path fails at once.
+    let mut out: Box<dyn Write> = match &args.output {
+        Some(path) => Box::new(BufWriter::new(
+            File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
+        )),
+        None => Box::new(BufWriter::new(io::stdout().lock())),
+    };
+    let frame = render(&scene, &camera, &lights, &settings, w, h);
+    let written = match format {
+        Format::Png => frame.image.write_png(&mut out),
+        Format::Pfm => frame.image.write_pfm(&mut out),
+        Format::Ansi | Format::Ansi256 | Format::Ascii => {
+            let mode = match format {
+                Format::Ansi => ColorMode::TrueColor,
+                Format::Ansi256 => ColorMode::Ansi256,
+                _ => ColorMode::Ascii,
+            };
+            out.write_all(&encode_text(&CellGrid::from_image(&frame.image, mode)))
+        }
+    };
+    written.and_then(|()| out.flush()).with_context(|| {
+        format!(
+            "cannot write to {}",
+            args.output
+                .as_ref()
+                .map_or_else(|| "stdout".to_string(), |p| p.display().to_string())
+        )
+    })
+}
+
+/// `message` without the " (os error N)" that Rust's I/O errors end with: the words before it
+/// say it all, and the number means nothing to a user.
+pub(super) fn without_os_error(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(i) = rest.find(" (os error ") {
+        let after = &rest[i + " (os error ".len()..];
+        let digits = after.chars().take_while(char::is_ascii_digit).count();
+        if digits > 0 && after[digits..].starts_with(')') {
+            out.push_str(&rest[..i]);
+            rest = &after[digits + 1..];
+        } else {
+            out.push_str(&rest[..i + 1]);
+            rest = &rest[i + 1..];
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The format an output file's extension implies: `.png` and `.pfm` are images, anything else
+/// (and stdout) gets truecolor text.
+pub(super) fn format_for(output: Option<&std::path::Path>) -> Format {
+    let ext = output
+        .and_then(|p| p.extension())
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png") => Format::Png,
+        Some("pfm") => Format::Pfm,
+        _ => Format::Ansi,
+    }
+}
+
+/// The extension of an image format raytty cannot write (`jpg`, `gif`, …), so that `-o
+/// box.jpg` is refused instead of filled with terminal text.
+pub(super) fn unwritable_image_extension(path: &std::path::Path) -> Option<String> {
+    const IMAGES: [&str; 12] = [
+        "jpg", "jpeg", "gif", "bmp", "tif", "tiff", "webp", "avif", "heic", "exr", "hdr", "ppm",
+    ];
+    let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+    IMAGES.contains(&ext.as_str()).then_some(ext)
+}
+
+/// A format's name as `--format` spells it.
+pub(super) fn format_name(format: Format) -> String {
+    format
+        .to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_string())
+}
+
+/// The scene's lights, with the first one moved to `light` if given.
+pub(super) fn lights_with(scene: &Scene, light: Option<Vec3>) -> Vec<PointLight> {
+    let mut lights = scene.lights.clone();
+    if let (Some(p), Some(first)) = (light, lights.first_mut()) {
+        first.position = p;
+    }
+    lights
+}
