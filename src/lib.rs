@@ -24,8 +24,6 @@ pub mod render;
 pub mod rng;
 pub mod scene;
 pub mod shading;
-pub mod tri4;
-pub mod flat4;
 
 pub use accel::{AccelKind, AccelStats, Hit};
 pub use camera::Camera;

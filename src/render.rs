@@ -1,4 +1,5 @@
-//! The render loop: primary rays for every pixel, rows in parallel, shaded by [`Tracer`].
+//! The render loop: primary rays for every pixel, in 8×8 tiles (bands of tiles in parallel),
+//! shaded by [`Tracer`].
 //!
 //! A frame's pixels depend only on (scene, camera, lights, settings, size): each sample's random
 //! numbers are seeded from (pixel, sample, frame), and the ray counts are integer sums, so the
@@ -122,20 +123,20 @@ pub fn render_cached(
         }
         let counts = image
             .pixels
-            .par_chunks_mut(w)
-            .zip(cache.hits.par_chunks_mut(w))
+            .par_chunks_mut(w * TILE)
+            .zip(cache.hits.par_chunks_mut(w * TILE))
             .enumerate()
-            .map(|(y, (row, hits))| {
+            .map(|(band, (pixels, hits))| {
                 let mut n = RayCounts::default();
-                for (x, (px, hit)) in row.iter_mut().zip(hits.iter_mut()).enumerate() {
+                for_each_in_tiles(band, w, pixels.len(), |x, y, i| {
                     let ray = rays.ray(x as f32 + 0.5, y as f32 + 0.5);
                     if !reuse {
                         n.primary += 1;
-                        *hit = scene.intersect(&ray, f32::INFINITY);
+                        hits[i] = scene.intersect(&ray, f32::INFINITY);
                     }
                     let mut rng = Rng::for_sample((y * w + x) as u64, 0, settings.frame);
-                    *px = tracer.shade_primary(&ray, *hit, &mut rng, &mut n);
-                }
+                    pixels[i] = tracer.shade_primary(&ray, hits[i], &mut rng, &mut n);
+                });
                 n
             })
             .reduce(RayCounts::default, sum);
@@ -146,11 +147,11 @@ pub fn render_cached(
         let square = strata * strata == samples;
         image
             .pixels
-            .par_chunks_mut(w)
+            .par_chunks_mut(w * TILE)
             .enumerate()
-            .map(|(y, row)| {
+            .map(|(band, pixels)| {
                 let mut n = RayCounts::default();
-                for (x, px) in row.iter_mut().enumerate() {
+                for_each_in_tiles(band, w, pixels.len(), |x, y, i| {
                     let mut acc = Vec3::ZERO;
                     for s in 0..samples {
                         let mut rng = Rng::for_sample((y * w + x) as u64, s, settings.frame);
@@ -169,8 +170,8 @@ pub fn render_cached(
                         let hit = scene.intersect(&ray, f32::INFINITY);
                         acc += tracer.shade_primary(&ray, hit, &mut rng, &mut n);
                     }
-                    *px = acc / samples as f32;
-                }
+                    pixels[i] = acc / samples as f32;
+                });
                 n
             })
             .reduce(RayCounts::default, sum)
@@ -185,7 +186,73 @@ pub fn render_cached(
     }
 }
 
+/// Side of the square tiles the frame is rendered in: a band of `TILE` rows is one parallel
+/// task, walked tile by tile so that neighbouring rays (which visit the same nodes and
+/// triangles) follow each other.
+pub const TILE: usize = 8;
+
+/// Calls `f(x, y, i)` for the pixels of band `band` (rows `band·TILE..`) of a `w`-wide frame,
+/// whose slice holds `len` pixels, tile by tile; `i` is the index in the band's slice.
+#[inline(always)]
+fn for_each_in_tiles(band: usize, w: usize, len: usize, mut f: impl FnMut(usize, usize, usize)) {
+    let rows = len / w;
+    for x0 in (0..w).step_by(TILE) {
+        for dy in 0..rows {
+            for x in x0..(x0 + TILE).min(w) {
+                f(x, band * TILE + dy, dy * w + x);
+            }
+        }
+    }
+}
+
 fn sum(mut a: RayCounts, b: RayCounts) -> RayCounts {
     a += b;
     a
+}
+
+impl FrameStats {
+    /// Millions of rays (all kinds) per second of the render's wall-clock time.
+    pub fn mrays_per_s(&self) -> f64 {
+        let s = self.elapsed.as_secs_f64();
+        if s > 0.0 {
+            self.rays.total() as f64 / s / 1e6
+        } else {
+            0.0
+        }
+    }
+
+    /// One line for people: time, samples, rays by kind, M rays/s and the SIMD path.
+    pub fn summary(&self, isa: crate::accel::Isa) -> String {
+        let r = &self.rays;
+        format!(
+            "{:.2} ms, {} spp, rays: {} primary, {} shadow, {} bounce, {} reflection; {:.2} M rays/s ({}, {} threads)",
+            self.elapsed.as_secs_f64() * 1e3,
+            self.samples,
+            r.primary,
+            r.shadow,
+            r.bounce,
+            r.reflection,
+            self.mrays_per_s(),
+            isa.name(),
+            rayon::current_num_threads()
+        )
+    }
+
+    /// The same as one JSON object: `ms`, `spp`, `rays` (by kind), `mrays_per_s`, and the
+    /// `simd` path and `threads`.
+    pub fn to_json(&self, isa: crate::accel::Isa) -> String {
+        let r = &self.rays;
+        format!(
+            "{{\"ms\":{:.3},\"spp\":{},\"rays\":{{\"primary\":{},\"shadow\":{},\"bounce\":{},\"reflection\":{}}},\"mrays_per_s\":{:.3},\"simd\":\"{}\",\"threads\":{}}}",
+            self.elapsed.as_secs_f64() * 1e3,
+            self.samples,
+            r.primary,
+            r.shadow,
+            r.bounce,
+            r.reflection,
+            self.mrays_per_s(),
+            isa.name(),
+            rayon::current_num_threads()
+        )
+    }
 }

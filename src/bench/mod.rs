@@ -10,6 +10,7 @@ pub mod metrics;
 pub mod output;
 pub mod reference;
 pub mod scene;
+pub mod throughput;
 
 use std::io;
 use std::path::PathBuf;

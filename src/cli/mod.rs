@@ -123,6 +123,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
             camera: None,
             light: None,
             output: None,
+            stats: None,
         },
         scene,
         false,

@@ -95,7 +95,15 @@ pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool)
                 .as_ref()
                 .map_or_else(|| "stdout".to_string(), |p| p.display().to_string())
         )
-    })
+    })?;
+    match args.stats {
+        Some(StatsFormat::Text) => {
+            eprintln!("raytty: {w}x{h}, {}", frame.stats.summary(scene.isa()))
+        }
+        Some(StatsFormat::Json) => eprintln!("{}", frame.stats.to_json(scene.isa())),
+        None => {}
+    }
+    Ok(())
 }
 
 /// `message` without the " (os error N)" that Rust's I/O errors end with: the words before it

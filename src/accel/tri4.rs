@@ -26,61 +26,13 @@
 
 use glam::Vec3;
 
-use crate::accel::Hit;
-use crate::flat4::Box4;
+use super::box4::Box4;
+use super::hit::{Hit, shrunk_t_max};
+use super::isa::Isa;
 use crate::geometry::{Ray, intersect_watertight};
 
 /// Triangles per [`Tri4`] block.
 pub const LANES: usize = 4;
-
-/// The SIMD instruction set a kernel uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Isa {
-    /// One lane at a time, in plain Rust (any target).
-    Portable,
-    /// Four lanes (x86-64's baseline).
-    Sse2,
-    /// Eight lanes, two blocks at a time (x86-64 CPUs from 2013 on; detected at run time).
-    Avx2,
-}
-
-impl Isa {
-    /// Every path, narrowest first.
-    pub const ALL: [Isa; 3] = [Isa::Portable, Isa::Sse2, Isa::Avx2];
-
-    /// The widest path this CPU runs.
-    pub fn detect() -> Isa {
-        if Isa::Avx2.available() {
-            Isa::Avx2
-        } else if Isa::Sse2.available() {
-            Isa::Sse2
-        } else {
-            Isa::Portable
-        }
-    }
-
-    /// Whether this CPU runs the path.
-    pub fn available(self) -> bool {
-        match self {
-            Isa::Portable => true,
-            #[cfg(target_arch = "x86_64")]
-            Isa::Sse2 => true,
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => std::is_x86_feature_detected!("avx2"),
-            #[cfg(not(target_arch = "x86_64"))]
-            _ => false,
-        }
-    }
-
-    /// A short lower-case name ("portable", "sse2", "avx2").
-    pub fn name(self) -> &'static str {
-        match self {
-            Isa::Portable => "portable",
-            Isa::Sse2 => "sse2",
-            Isa::Avx2 => "avx2",
-        }
-    }
-}
 
 /// Four triangles' vertices, structure of arrays: `v[vertex][axis][lane]`. Unused lanes hold NaN,
 /// which no test accepts (the determinant is NaN).
@@ -93,12 +45,17 @@ pub struct Tri4 {
 /// Equal when every coordinate has the same bits (so the NaN padding compares equal).
 impl PartialEq for Tri4 {
     fn eq(&self, o: &Tri4) -> bool {
-        self.v.as_flattened().as_flattened().iter().map(|x| x.to_bits()).eq(o
-            .v
+        self.v
             .as_flattened()
             .as_flattened()
             .iter()
-            .map(|x| x.to_bits()))
+            .map(|x| x.to_bits())
+            .eq(o
+                .v
+                .as_flattened()
+                .as_flattened()
+                .iter()
+                .map(|x| x.to_bits()))
     }
 }
 
@@ -213,7 +170,11 @@ pub fn candidates_portable(block: &Tri4, r: &RayLanes, t_max: f32) -> Candidates
         let mut y = [0f32; 3];
         let mut z = [0f32; 3];
         for i in 0..3 {
-            let (a, b, c) = (v[i][kx][lane] - ox, v[i][ky][lane] - oy, v[i][kz][lane] - oz);
+            let (a, b, c) = (
+                v[i][kx][lane] - ox,
+                v[i][ky][lane] - oy,
+                v[i][kz][lane] - oz,
+            );
             x[i] = a + sx * c;
             y[i] = b + sy * c;
             z[i] = c;
@@ -328,18 +289,25 @@ mod x86 {
                 _mm_mul_ps(e2, _mm_mul_ps(sz, z2)),
             );
             let bound = _mm_mul_ps(_mm_set1_ps(t_max), det);
-            // det < 0: keep 0 > t_scaled >= bound; det > 0: keep 0 < t_scaled <= bound. A NaN
-            // or zero det keeps neither.
-            let neg_ok = _mm_and_ps(
-                _mm_cmplt_ps(det, zero),
-                _mm_and_ps(_mm_cmplt_ps(t_scaled, zero), _mm_cmpge_ps(t_scaled, bound)),
+            // Rejected as the scalar test rejects: mixed signs, a zero or NaN det, or t·det
+            // outside (0, t_max·det] (on det's side). A NaN t·det is not rejected here.
+            let reject = _mm_or_ps(
+                _mm_or_ps(
+                    _mm_and_ps(any_neg, any_pos),
+                    _mm_or_ps(_mm_cmpeq_ps(det, zero), _mm_cmpunord_ps(det, det)),
+                ),
+                _mm_or_ps(
+                    _mm_and_ps(
+                        _mm_cmplt_ps(det, zero),
+                        _mm_or_ps(_mm_cmpge_ps(t_scaled, zero), _mm_cmplt_ps(t_scaled, bound)),
+                    ),
+                    _mm_and_ps(
+                        _mm_cmpgt_ps(det, zero),
+                        _mm_or_ps(_mm_cmple_ps(t_scaled, zero), _mm_cmpgt_ps(t_scaled, bound)),
+                    ),
+                ),
             );
-            let pos_ok = _mm_and_ps(
-                _mm_cmpgt_ps(det, zero),
-                _mm_and_ps(_mm_cmpgt_ps(t_scaled, zero), _mm_cmple_ps(t_scaled, bound)),
-            );
-            let keep = _mm_andnot_ps(_mm_and_ps(any_neg, any_pos), _mm_or_ps(neg_ok, pos_ok));
-            let mask = _mm_movemask_ps(_mm_or_ps(any_zero, keep)) as u32;
+            let mask = (!_mm_movemask_ps(reject) as u32 & 0xf) | _mm_movemask_ps(any_zero) as u32;
             let mut out = Candidates {
                 mask,
                 t: [0.0; 2 * LANES],
@@ -427,25 +395,33 @@ mod x86 {
                 _mm256_mul_ps(e2, _mm256_mul_ps(sz, z2)),
             );
             let bound = _mm256_mul_ps(_mm256_set1_ps(t_max), det);
-            let neg_ok = _mm256_and_ps(
-                _mm256_cmp_ps::<_CMP_LT_OQ>(det, zero),
-                _mm256_and_ps(
-                    _mm256_cmp_ps::<_CMP_LT_OQ>(t_scaled, zero),
-                    _mm256_cmp_ps::<_CMP_GE_OQ>(t_scaled, bound),
+            let reject = _mm256_or_ps(
+                _mm256_or_ps(
+                    _mm256_and_ps(any_neg, any_pos),
+                    _mm256_or_ps(
+                        _mm256_cmp_ps::<_CMP_EQ_OQ>(det, zero),
+                        _mm256_cmp_ps::<_CMP_UNORD_Q>(det, det),
+                    ),
+                ),
+                _mm256_or_ps(
+                    _mm256_and_ps(
+                        _mm256_cmp_ps::<_CMP_LT_OQ>(det, zero),
+                        _mm256_or_ps(
+                            _mm256_cmp_ps::<_CMP_GE_OQ>(t_scaled, zero),
+                            _mm256_cmp_ps::<_CMP_LT_OQ>(t_scaled, bound),
+                        ),
+                    ),
+                    _mm256_and_ps(
+                        _mm256_cmp_ps::<_CMP_GT_OQ>(det, zero),
+                        _mm256_or_ps(
+                            _mm256_cmp_ps::<_CMP_LE_OQ>(t_scaled, zero),
+                            _mm256_cmp_ps::<_CMP_GT_OQ>(t_scaled, bound),
+                        ),
+                    ),
                 ),
             );
-            let pos_ok = _mm256_and_ps(
-                _mm256_cmp_ps::<_CMP_GT_OQ>(det, zero),
-                _mm256_and_ps(
-                    _mm256_cmp_ps::<_CMP_GT_OQ>(t_scaled, zero),
-                    _mm256_cmp_ps::<_CMP_LE_OQ>(t_scaled, bound),
-                ),
-            );
-            let keep = _mm256_andnot_ps(
-                _mm256_and_ps(any_neg, any_pos),
-                _mm256_or_ps(neg_ok, pos_ok),
-            );
-            let mask = _mm256_movemask_ps(_mm256_or_ps(any_zero, keep)) as u32;
+            let mask =
+                (!_mm256_movemask_ps(reject) as u32 & 0xff) | _mm256_movemask_ps(any_zero) as u32;
             let mut out = Candidates {
                 mask,
                 t: [0.0; 2 * LANES],
@@ -547,7 +523,11 @@ impl Kernel for Avx2 {
 /// The candidates of one block on path `isa` (for tests and tools; traversals call the kernels
 /// directly). `isa` must be available.
 pub fn candidates(isa: Isa, block: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
-    assert!(isa.available(), "{} is not available on this CPU", isa.name());
+    assert!(
+        isa.available(),
+        "{} is not available on this CPU",
+        isa.name()
+    );
     match isa {
         Isa::Portable => candidates_portable(block, r, t_max),
         #[cfg(target_arch = "x86_64")]
@@ -562,7 +542,11 @@ pub fn candidates(isa: Isa, block: &Tri4, r: &RayLanes, t_max: f32) -> Candidate
 
 /// The candidates of two blocks on path `isa` (lanes 4-7 from `b`). `isa` must be available.
 pub fn candidates2(isa: Isa, a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
-    assert!(isa.available(), "{} is not available on this CPU", isa.name());
+    assert!(
+        isa.available(),
+        "{} is not available on this CPU",
+        isa.name()
+    );
     match isa {
         Isa::Portable => candidates2_portable(a, b, r, t_max),
         #[cfg(target_arch = "x86_64")]
@@ -576,7 +560,7 @@ pub fn candidates2(isa: Isa, a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Ca
 }
 
 /// The closest-hit search's state: the best hit so far and the `t_max` a triangle is tested
-/// with (four ULPs above it, see [`crate::bvh::shrunk_t_max`]).
+/// with (four ULPs above it, see [`shrunk_t_max`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Closest {
     pub best: Option<Hit>,
@@ -637,7 +621,7 @@ impl Closest {
                     b: h.b,
                     triangle: i,
                 });
-                self.tri_t_max = crate::bvh::shrunk_t_max(h.t, self.t_max);
+                self.tri_t_max = shrunk_t_max(h.t, self.t_max);
             }
         }
     }
@@ -658,6 +642,62 @@ pub(crate) fn any_confirmed(
             return true;
         }
         m &= m - 1;
+    }
+    false
+}
+
+/// Folds the closest hit among consecutive `blocks` (whose lanes' scene indices are `ids`) into
+/// `c`: two blocks per step where there are two.
+#[inline(always)]
+pub(crate) fn blocks_closest<K: Kernel>(
+    blocks: &[Tri4],
+    ids: &[u32],
+    ray: &Ray,
+    r: &RayLanes,
+    c: &mut Closest,
+) {
+    let mut b = 0;
+    while b < blocks.len() {
+        let (cand, n) = if b + 1 < blocks.len() {
+            (K::two(&blocks[b], &blocks[b + 1], r, c.tri_t_max), 2)
+        } else {
+            (K::one(&blocks[b], r, c.tri_t_max), 1)
+        };
+        if cand.mask != 0 {
+            c.take(
+                ray,
+                cand,
+                |l| blocks[b + l / LANES].vertices(l % LANES),
+                |l| ids[b * LANES + l],
+            );
+        }
+        b += n;
+    }
+}
+
+/// Whether a triangle of `blocks` has a hit before `t_max`.
+#[inline(always)]
+pub(crate) fn blocks_occluded<K: Kernel>(
+    blocks: &[Tri4],
+    ray: &Ray,
+    r: &RayLanes,
+    t_max: f32,
+) -> bool {
+    let mut b = 0;
+    while b < blocks.len() {
+        let (cand, n) = if b + 1 < blocks.len() {
+            (K::two(&blocks[b], &blocks[b + 1], r, t_max), 2)
+        } else {
+            (K::one(&blocks[b], r, t_max), 1)
+        };
+        if cand.mask != 0
+            && any_confirmed(ray, cand, t_max, |l| {
+                blocks[b + l / LANES].vertices(l % LANES)
+            })
+        {
+            return true;
+        }
+        b += n;
     }
     false
 }
