@@ -31,7 +31,7 @@ static EPOCH: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
 /// Closest-hit queries per second of this thread's time (best of 5), for the camera rays of a
 /// `w`×`h` frame.
 fn trace_rate(scene: &Scene, w: u32, h: u32) -> f64 {
-    let camera_rays = scene.camera.rays(w, h);
+    let camera_rays = scene.camera().rays(w, h);
     let rays: Vec<_> = (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
         .map(|(x, y)| camera_rays.ray(x as f32 + 0.5, y as f32 + 0.5))
@@ -147,7 +147,7 @@ fn main() {
     println!("| triangles | flat M rays/s | BVH M rays/s |\n| ---: | ---: | ---: |");
     for small_k in [1, 2, 3, 4, 6] {
         let (scene, ..) = sphere_scene(small_k);
-        let n = scene.triangles.len();
+        let n = scene.triangles().len();
         let flat = trace_rate(&scene.clone().with_accel(AccelKind::Flat), 300, 300);
         let bvh = trace_rate(&scene.with_accel(AccelKind::Bvh), 300, 300);
         println!("| {n} | {flat:.2} | {bvh:.2} |");
@@ -162,7 +162,7 @@ fn main() {
     let stats = scene.accel_stats();
     println!(
         "{} triangles: mesh generated in {:.1} ms; SceneBuilder::build (validation + {}) {:.1} ms, of which the BVH {:.1} ms ({} nodes, depth {})",
-        scene.triangles.len(),
+        scene.triangles().len(),
         generate.as_secs_f64() * 1e3,
         stats.kind.name(),
         build.as_secs_f64() * 1e3,

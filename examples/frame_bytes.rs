@@ -40,11 +40,11 @@ fn naive(grid: &CellGrid) -> usize {
 
 fn main() {
     let scene = cornell_box();
-    let settings = Stage::Indirect.settings(scene.effects);
+    let settings = Stage::Indirect.settings(scene.effects());
     let (w, h) = (COLS, 2 * (ROWS - 1));
     for sweep in ["light moves (D)", "camera turns (Right)"] {
-        let mut camera = scene.camera;
-        let mut lights = scene.lights.clone();
+        let mut camera = scene.camera();
+        let mut lights = scene.lights().to_vec();
         let mut cache = HitCache::new();
         let mut prev: Option<CellGrid> = None;
         let (mut diff_bytes, mut naive_bytes) = (0, 0);

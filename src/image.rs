@@ -4,6 +4,11 @@ use std::io::{self, Write};
 
 use glam::Vec3;
 
+/// Most pixels one image may have, for every frame, bench size and image file raytty makes or
+/// reads: about 48 bytes each while rendering (float image, cached hits, 8-bit copy, encoder
+/// buffers), so 64 Mpixel stays near 3 GiB.
+pub const MAX_PIXELS: u64 = 64 * 1024 * 1024;
+
 /// A linear RGB image, row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {

@@ -7,8 +7,8 @@
 //! ```
 //! use raytty::{cornell_box, render, CellGrid, ColorMode, Stage, encode_text};
 //! let scene = cornell_box();
-//! let settings = Stage::Indirect.settings(scene.effects);
-//! let frame = render(&scene, &scene.camera, &scene.lights, &settings, 40, 24);
+//! let settings = Stage::Indirect.settings(scene.effects());
+//! let frame = render(&scene, &scene.camera(), scene.lights(), &settings, 40, 24);
 //! let text = encode_text(&CellGrid::from_image(&frame.image, ColorMode::Ascii));
 //! assert_eq!(text.iter().filter(|&&b| b == b'\n').count(), 12);
 //! ```

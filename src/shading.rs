@@ -9,7 +9,7 @@ use glam::Vec3;
 use crate::accel::Hit;
 use crate::geometry::{Ray, hit_point, offset_ray_origin};
 use crate::rng::Rng;
-use crate::scene::{Effects, Indirect, PointLight, Scene};
+use crate::scene::{Effects, Indirect, Material, PointLight, Scene};
 
 /// The seed's stages, selectable by name and by the keys 1-6.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -219,8 +219,8 @@ impl<'a> Tracer<'a> {
         rng: &mut Rng,
         n: &mut RayCounts,
     ) -> Vec3 {
-        let tri = &self.scene.triangles[hit.triangle as usize];
-        let material = &self.scene.materials[tri.material as usize];
+        let tri = &self.scene.triangles()[hit.triangle as usize];
+        let material = &self.scene.materials()[tri.material as usize];
         if self.settings.mode == Mode::Flat {
             return material.colour;
         }
@@ -231,11 +231,46 @@ impl<'a> Tracer<'a> {
         } else {
             tri.normal
         };
-        let direct = self.direct(p, err, normal, n);
         if self.settings.mode == Mode::Irradiance {
-            return direct;
+            return self.direct(p, err, normal, n);
         }
-        let indirect = match self.settings.effects.indirect {
+        let reflects = material.mirror > 0.0 && mirror_depth < MAX_MIRROR_DEPTH;
+        // What cannot change the pixel is not traced: a perfect mirror's own shading is
+        // weighted by 1 − mirror = 0, and a black surface's by ρ = 0.
+        let diffuse = if (reflects && material.mirror >= 1.0) || material.colour == Vec3::ZERO {
+            Vec3::ZERO
+        } else {
+            material.colour
+                * (self.direct(p, err, normal, n)
+                    + self.indirect(material, p, err, normal, mirror_depth, bounce, rng, n))
+        };
+        if reflects {
+            let d = ray.dir.normalize();
+            let dir = d - 2.0 * d.dot(normal) * normal;
+            let origin = offset_ray_origin(p, err, normal, dir);
+            n.reflection += 1;
+            let reflected = self.trace(&Ray::new(origin, dir), mirror_depth + 1, bounce, rng, n);
+            diffuse * (1.0 - material.mirror) + reflected * material.mirror
+        } else {
+            diffuse
+        }
+    }
+
+    /// The indirect irradiance at a diffuse hit: the seed's constant, or one path-traced
+    /// bounce (with Russian roulette past [`ROULETTE_START`] bounces).
+    #[allow(clippy::too_many_arguments)]
+    fn indirect(
+        &self,
+        material: &Material,
+        p: Vec3,
+        err: Vec3,
+        normal: Vec3,
+        mirror_depth: u32,
+        bounce: u32,
+        rng: &mut Rng,
+        n: &mut RayCounts,
+    ) -> Vec3 {
+        match self.settings.effects.indirect {
             Indirect::None => Vec3::ZERO,
             Indirect::Constant(k) => Vec3::splat(k),
             Indirect::PathTraced { bounces } if bounce < bounces => {
@@ -257,17 +292,6 @@ impl<'a> Tracer<'a> {
                 }
             }
             Indirect::PathTraced { .. } => Vec3::ZERO,
-        };
-        let diffuse = material.colour * (direct + indirect);
-        if material.mirror > 0.0 && mirror_depth < MAX_MIRROR_DEPTH {
-            let d = ray.dir.normalize();
-            let dir = d - 2.0 * d.dot(normal) * normal;
-            let origin = offset_ray_origin(p, err, normal, dir);
-            n.reflection += 1;
-            let reflected = self.trace(&Ray::new(origin, dir), mirror_depth + 1, bounce, rng, n);
-            diffuse * (1.0 - material.mirror) + reflected * material.mirror
-        } else {
-            diffuse
         }
     }
 
@@ -277,6 +301,10 @@ impl<'a> Tracer<'a> {
     pub fn direct(&self, p: glam::Vec3, err: Vec3, normal: Vec3, n: &mut RayCounts) -> Vec3 {
         let mut sum = Vec3::ZERO;
         for light in self.lights {
+            // A dark light adds nothing: no shadow ray for it.
+            if light.power == Vec3::ZERO {
+                continue;
+            }
             let to_light = light.position - p;
             let dist2 = to_light.length_squared();
             if !(dist2 > 0.0) {

@@ -116,7 +116,7 @@ fn assert_exact(triangles: Vec<[Vec3; 3]>, seed: u64, n_rays: usize, reach: f32)
     let flat = scene_of(triangles, AccelKind::Flat);
     assert_eq!(bvh.accel_stats().kind, AccelKind::Bvh);
     assert_eq!(flat.accel_stats().kind, AccelKind::Flat);
-    let tris = &bvh.triangles;
+    let tris = bvh.triangles();
     let mut hits = 0;
     for (i, (ray, t_max)) in rays(seed, tris, n_rays, reach).into_iter().enumerate() {
         let want = brute_force(tris, &ray, t_max);
@@ -211,7 +211,7 @@ fn identical_centroids_terminate_and_tie_to_the_lowest_index() {
     let ray = Ray::new(Vec3::new(0.01, 0.02, -2.0), Vec3::Z);
     assert_eq!(
         s.intersect(&ray, f32::INFINITY),
-        brute_force(&s.triangles, &ray, f32::INFINITY)
+        brute_force(s.triangles(), &ray, f32::INFINITY)
     );
     assert_exact(tris, 12, 2_000, 3.0);
     // Exact duplicates too: the same t, so the first one wins.
@@ -238,7 +238,7 @@ fn huge_and_tiny_coordinates() {
         (2e38, 0.1),
     ] {
         let bvh = scene_of(soup(21, 1_000, 1.0, 0.2, scale), AccelKind::Bvh);
-        let t = &bvh.triangles;
+        let t = bvh.triangles();
         assert!(bvh.accel_stats().nodes > 100, "scale {scale}: not split");
         let mut hits = 0;
         for (i, (ray, t_max)) in rays(22, t, 2_000, reach * scale).into_iter().enumerate() {
@@ -252,8 +252,8 @@ fn huge_and_tiny_coordinates() {
 }
 
 fn frame_bytes(scene: &Scene, stage: Stage, w: u32, h: u32) -> (Vec<u8>, raytty::RayCounts) {
-    let settings = stage.settings(scene.effects);
-    let f = render(scene, &scene.camera, &scene.lights, &settings, w, h);
+    let settings = stage.settings(scene.effects());
+    let f = render(scene, &scene.camera(), scene.lights(), &settings, w, h);
     let bytes = f
         .image
         .pixels

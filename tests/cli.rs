@@ -254,19 +254,33 @@ fn bench_flags_that_would_be_ignored_or_fail_late_are_refused_first() {
     for (args, needle) in [
         (
             &["bench", "--scene", "cornell", "--csv"][..],
-            "--csv belong to the accuracy bench",
+            "cannot be used with '--csv'",
         ),
+        // --scene before the subcommand: the same declared conflict.
         (
             &[
-                "bench",
                 "--scene",
                 "cornell",
+                "bench",
                 "--svg",
                 "p.svg",
                 "--max-spp",
                 "4",
             ],
-            "--svg, --max-spp belong",
+            "the argument '--max-spp' cannot be used with '--scene",
+        ),
+        (
+            &["--scene", "cornell", "bench", "--ref-spp", "16"],
+            "the argument '--ref-spp' cannot be used with '--scene",
+        ),
+        // One pixel cap for every bench, with or without --scene.
+        (
+            &["bench", "--scene", "cornell", "--sizes", "65535x65535"],
+            "--sizes 65535x65535 is too large: at most 67108864 pixels",
+        ),
+        (
+            &["bench", "--sizes", "8193x8193"],
+            "--sizes 8193x8193 is too large: at most 67108864 pixels",
         ),
         (
             &["bench", "--quick", "--svg", "/nonexistent/plot.svg"],

@@ -8,11 +8,11 @@ use raytty::{Stage, cornell_box, render};
 fn every_pixel_of_the_seed_view_hits_the_box() {
     let scene = cornell_box();
     for stage in Stage::ALL {
-        let mut settings = stage.settings(scene.effects);
+        let mut settings = stage.settings(scene.effects());
         if stage == Stage::Gi {
             settings.effects.samples = 1;
         }
-        let frame = render(&scene, &scene.camera, &scene.lights, &settings, 500, 500);
+        let frame = render(&scene, &scene.camera(), scene.lights(), &settings, 500, 500);
         assert_eq!(frame.stats.rays.primary, 250_000);
         for (i, p) in frame.image.pixels.iter().enumerate() {
             assert!(p.is_finite(), "{stage:?}: pixel {i} is {p}");
@@ -36,9 +36,9 @@ fn every_pixel_of_the_seed_view_hits_the_box() {
 fn other_frame_shapes_see_the_whole_opening_too() {
     // With f = the shorter side, the opening fills the shorter side at any aspect ratio.
     let scene = cornell_box();
-    let settings = Stage::Flat.settings(scene.effects);
+    let settings = Stage::Flat.settings(scene.effects());
     for (w, h) in [(200, 100), (100, 200), (81, 47)] {
-        let frame = render(&scene, &scene.camera, &scene.lights, &settings, w, h);
+        let frame = render(&scene, &scene.camera(), scene.lights(), &settings, w, h);
         let (cx, cy) = (w / 2, h / 2);
         let r = w.min(h) / 2 - 1;
         for y in cy - r..cy + r {

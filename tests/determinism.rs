@@ -12,9 +12,9 @@ fn image_bytes(threads: usize, stage: Stage, samples: u32) -> Vec<u8> {
         .unwrap();
     pool.install(|| {
         let scene = cornell_box();
-        let mut settings = stage.settings(scene.effects);
+        let mut settings = stage.settings(scene.effects());
         settings.effects.samples = samples;
-        let f = render(&scene, &scene.camera, &scene.lights, &settings, 64, 48);
+        let f = render(&scene, &scene.camera(), scene.lights(), &settings, 64, 48);
         float_bytes(&f.image)
     })
 }
@@ -51,13 +51,13 @@ fn path_traced_frames_are_deterministic_across_threads() {
             .build()
             .unwrap()
             .install(|| {
-                let mut s = Stage::Indirect.settings(scene.effects);
+                let mut s = Stage::Indirect.settings(scene.effects());
                 s.effects = Effects {
                     shadows: true,
                     indirect: Indirect::PathTraced { bounces: 3 },
                     samples: 2,
                 };
-                render(&scene, &scene.camera, &scene.lights, &s, 40, 30).image
+                render(&scene, &scene.camera(), scene.lights(), &s, 40, 30).image
             })
     };
     assert_eq!(run(1), run(2));
@@ -100,15 +100,15 @@ fn fingerprint(bytes: &[u8]) -> u64 {
 #[test]
 fn frames_are_bit_identical_to_the_committed_fingerprints() {
     let scene = cornell_box();
-    let mut camera = scene.camera;
+    let mut camera = scene.camera();
     camera.yaw = 7f32.to_radians();
     camera.position.x = 0.1;
     let got: Vec<(Stage, u64)> = Stage::ALL
         .into_iter()
         .map(|stage| {
-            let mut settings = stage.settings(scene.effects);
+            let mut settings = stage.settings(scene.effects());
             settings.effects.samples = 4;
-            let f = render(&scene, &camera, &scene.lights, &settings, 48, 32);
+            let f = render(&scene, &camera, scene.lights(), &settings, 48, 32);
             (stage, fingerprint(&float_bytes(&f.image)))
         })
         .collect();

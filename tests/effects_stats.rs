@@ -21,7 +21,7 @@ fn settings(shadows: bool, indirect: Indirect, samples: u32) -> Settings {
 }
 
 fn stats(scene: &Scene, s: &Settings) -> FrameStats {
-    render(scene, &scene.camera, &scene.lights, s, W, H).stats
+    render(scene, &scene.camera(), scene.lights(), s, W, H).stats
 }
 
 const GI4: Indirect = Indirect::PathTraced { bounces: 4 };
@@ -54,7 +54,7 @@ fn constant_or_no_indirect_traces_no_bounce_ray() {
         Stage::Shadows,
         Stage::Indirect,
     ] {
-        let s = stats(&scene, &stage.settings(scene.effects));
+        let s = stats(&scene, &stage.settings(scene.effects()));
         assert_eq!(s.rays.bounce, 0, "{stage:?}");
     }
 }
@@ -86,11 +86,11 @@ fn a_light_behind_every_visible_surface_costs_no_shadow_ray() {
         assert_eq!(s.rays.shadow, 0, "{indirect:?}");
     }
     // The control: the light moved in front of the wall casts shadow rays from every pixel.
-    let mut front = wall.lights.clone();
+    let mut front = wall.lights().to_vec();
     front[0].position.z = 0.0;
     let s = render(
         &wall,
-        &wall.camera,
+        &wall.camera(),
         &front,
         &settings(true, Indirect::Constant(0.5), 1),
         W,
@@ -104,26 +104,26 @@ fn a_light_behind_every_visible_surface_costs_no_shadow_ray() {
 fn a_light_only_change_traces_no_primary_ray() {
     let scene = cornell_box();
     let mut cache = HitCache::new();
-    let s = scene.effects;
+    let s = scene.effects();
     for stage in [Stage::Shadows, Stage::Indirect, Stage::Gi] {
         let settings = stage.settings(s);
         let first = render_cached(
             &scene,
-            &scene.camera,
-            &scene.lights,
+            &scene.camera(),
+            scene.lights(),
             &settings,
             W,
             H,
             &mut cache,
         );
         assert_eq!(first.stats.rays.primary, u64::from(W * H), "{stage:?}");
-        let mut moved = scene.lights.clone();
+        let mut moved = scene.lights().to_vec();
         moved[0].position += Vec3::new(0.2, 0.1, -0.1);
-        let second = render_cached(&scene, &scene.camera, &moved, &settings, W, H, &mut cache);
+        let second = render_cached(&scene, &scene.camera(), &moved, &settings, W, H, &mut cache);
         assert_eq!(second.stats.rays.primary, 0, "{stage:?}");
         assert!(second.stats.rays.shadow > 0, "{stage:?}");
         // Reusing the hits changes no pixel.
-        let fresh = render(&scene, &scene.camera, &moved, &settings, W, H);
+        let fresh = render(&scene, &scene.camera(), &moved, &settings, W, H);
         assert_eq!(second.image, fresh.image, "{stage:?}");
         cache.clear();
     }
@@ -134,7 +134,7 @@ fn no_mirrors_no_reflection_ray() {
     let scene = cornell_box();
     assert!(!scene.has_mirrors());
     for stage in Stage::ALL {
-        let s = stats(&scene, &stage.settings(scene.effects));
+        let s = stats(&scene, &stage.settings(scene.effects()));
         assert_eq!(s.rays.reflection, 0, "{stage:?}");
     }
     let s = stats(&scene, &settings(true, GI4, 4));
@@ -143,7 +143,7 @@ fn no_mirrors_no_reflection_ray() {
     // The control: the same box with a mirror back wall reflects.
     let mirror = mirrored_box();
     assert!(mirror.has_mirrors());
-    let s = stats(&mirror, &Stage::Indirect.settings(mirror.effects));
+    let s = stats(&mirror, &Stage::Indirect.settings(mirror.effects()));
     assert!(s.rays.reflection > 0);
 }
 
@@ -205,9 +205,9 @@ fn gi_with_b_bounces_traces_at_most_b_bounce_rays_per_path() {
     // its first bounce) and a miss sends none. The flat stage shows which pixels hit.
     let flat = render(
         &scene,
-        &scene.camera,
-        &scene.lights,
-        &Stage::Flat.settings(scene.effects),
+        &scene.camera(),
+        scene.lights(),
+        &Stage::Flat.settings(scene.effects()),
         W,
         H,
     );
@@ -249,8 +249,8 @@ fn gi_is_direct_light_plus_something() {
     let scene = cornell_box();
     let direct = render(
         &scene,
-        &scene.camera,
-        &scene.lights,
+        &scene.camera(),
+        scene.lights(),
         &settings(true, Indirect::None, 1),
         W,
         H,
@@ -259,8 +259,8 @@ fn gi_is_direct_light_plus_something() {
     let gi = |samples| {
         render(
             &scene,
-            &scene.camera,
-            &scene.lights,
+            &scene.camera(),
+            scene.lights(),
             &settings(true, Indirect::PathTraced { bounces: 8 }, samples),
             W,
             H,
@@ -278,8 +278,8 @@ fn gi_is_direct_light_plus_something() {
     );
     let direct16 = render(
         &scene,
-        &scene.camera,
-        &scene.lights,
+        &scene.camera(),
+        scene.lights(),
         &settings(true, Indirect::None, 16),
         W,
         H,
@@ -304,8 +304,8 @@ fn gi_is_the_same_with_one_thread_and_two() {
             .install(|| {
                 render(
                     &scene,
-                    &scene.camera,
-                    &scene.lights,
+                    &scene.camera(),
+                    scene.lights(),
                     &settings(true, Indirect::PathTraced { bounces: 8 }, 4),
                     W,
                     H,
@@ -315,4 +315,100 @@ fn gi_is_the_same_with_one_thread_and_two() {
     let (one, two) = (run(1), run(2));
     assert_eq!(one.image, two.image);
     assert_eq!(one.stats.rays, two.stats.rays);
+}
+
+/// A wall filling the view with `material`, lit from in front of it.
+fn wall_of(material: Material) -> Scene {
+    let mut b = SceneBuilder::new();
+    let m = b.material(material);
+    let v = |x, y, z| Vec3::new(x, y, z);
+    b.object(
+        [
+            [v(-9., -9., 1.), v(9., -9., 1.), v(9., 9., 1.)],
+            [v(-9., -9., 1.), v(9., 9., 1.), v(-9., 9., 1.)],
+        ],
+        m,
+    );
+    b.light(PointLight {
+        position: v(0.3, -0.2, 0.0),
+        power: Vec3::splat(14.0),
+    });
+    b.build("wall", Camera::default(), Effects::SEED)
+        .expect("valid")
+}
+
+/// A perfect mirror (mirror = 1) shows only what it reflects: its own direct and indirect light
+/// would be weighted by 0, so neither a shadow ray nor a bounce ray is traced for it; and a
+/// black surface (ρ = 0) likewise. A half mirror and a grey wall are the controls.
+#[test]
+fn a_perfect_mirror_or_a_black_surface_traces_no_shadow_or_bounce_ray() {
+    let px = u64::from(W * H);
+    let mirror = |m| Material {
+        colour: Vec3::splat(0.75),
+        mirror: m,
+    };
+    for indirect in [Indirect::Constant(0.5), GI4] {
+        let s = stats(&wall_of(mirror(1.0)), &settings(true, indirect, 1));
+        assert_eq!(s.rays.primary, px, "{indirect:?}");
+        assert_eq!(s.rays.reflection, px, "{indirect:?}: every pixel reflects");
+        assert_eq!((s.rays.shadow, s.rays.bounce), (0, 0), "{indirect:?}");
+        let black = stats(
+            &wall_of(Material::diffuse(Vec3::ZERO)),
+            &settings(true, indirect, 1),
+        );
+        assert_eq!(
+            (black.rays.shadow, black.rays.bounce),
+            (0, 0),
+            "{indirect:?}"
+        );
+        // The controls.
+        let half = stats(&wall_of(mirror(0.5)), &settings(true, indirect, 1));
+        assert_eq!(half.rays.shadow, px, "{indirect:?}");
+        let grey = stats(
+            &wall_of(Material::diffuse(Vec3::splat(0.5))),
+            &settings(true, indirect, 1),
+        );
+        assert_eq!(grey.rays.shadow, px, "{indirect:?}");
+        if indirect == GI4 {
+            assert_eq!(half.rays.bounce, px);
+            assert_eq!(grey.rays.bounce, px);
+        }
+    }
+    // What the mirror shows is unchanged: the reflected rays leave the scene, so it is black.
+    let wall = wall_of(mirror(1.0));
+    let f = render(
+        &wall,
+        &wall.camera(),
+        wall.lights(),
+        &settings(true, GI4, 1),
+        W,
+        H,
+    );
+    assert!(f.image.pixels.iter().all(|p| *p == Vec3::ZERO));
+}
+
+/// A light of zero power adds nothing, so it costs no shadow ray, and the frame is the one
+/// without it, bit for bit.
+#[test]
+fn a_dark_light_costs_no_shadow_ray() {
+    let scene = cornell_box();
+    let lit = scene.lights().to_vec();
+    let dark = PointLight {
+        position: lit[0].position + Vec3::new(0.1, 0.0, 0.0),
+        power: Vec3::ZERO,
+    };
+    for stage in Stage::ALL {
+        let s = stage.settings(scene.effects());
+        let frame = |lights: &[PointLight]| render(&scene, &scene.camera(), lights, &s, W, H);
+        let alone = frame(&[dark]);
+        assert_eq!(alone.stats.rays.shadow, 0, "{stage:?}");
+        assert_eq!(alone.image, frame(&[]).image, "{stage:?}");
+        let both = frame(&[lit[0], dark]);
+        let one = frame(&lit);
+        assert_eq!(both.stats.rays, one.stats.rays, "{stage:?}");
+        assert_eq!(both.image, one.image, "{stage:?}");
+    }
+    // The control: the same light with power casts shadow rays.
+    let s = stats(&scene, &settings(true, Indirect::Constant(0.5), 1));
+    assert!(s.rays.shadow > 0);
 }

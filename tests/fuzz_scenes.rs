@@ -183,9 +183,9 @@ fn check(scene: &str, mesh: &[u8], tally: &mut Tally) {
         let result = file::parse(scene, "fuzz.toml", "fuzz", &read);
         if let Ok(s) = &result {
             // A scene that loaded renders a finite frame (samples capped to keep it quick).
-            let mut settings = Stage::Indirect.settings(s.effects);
+            let mut settings = Stage::Indirect.settings(s.effects());
             settings.effects.samples = settings.effects.samples.min(2);
-            let frame = render(s, &s.camera, &s.lights, &settings, 6, 4);
+            let frame = render(s, &s.camera(), s.lights(), &settings, 6, 4);
             assert!(frame.image.pixels.iter().all(|p| p.is_finite()));
         }
         result

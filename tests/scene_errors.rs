@@ -301,3 +301,82 @@ fn control_characters_in_the_file_never_reach_the_terminal() {
         &["unknown key `evil[2J`"],
     );
 }
+
+/// Runs `raytty render --scene FILE` on `scene` (bytes) written to `d/scene.toml`, expects
+/// success, and returns the frame.
+fn renders(d: &Path, scene: &[u8]) -> String {
+    let path = d.join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_raytty"))
+        .args(["render", "--format", "ascii", "--size", "8x4", "--scene"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "stderr: {err}");
+    String::from_utf8(out.stdout).unwrap()
+}
+
+#[test]
+fn a_byte_order_mark_is_not_part_of_the_first_line() {
+    let d = dir("bom");
+    // An OBJ file from a Windows editor: its first vertex is still read, so the face is valid
+    // and renders as the same file without the mark does.
+    let obj = "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n";
+    let scene = format!(
+        "{BASE}[[object]]\nkind = \"obj\"\nmaterial = \"white\"\npath = \"m.obj\"\n[camera]\nposition = [0, 0, -3]\n"
+    );
+    std::fs::write(d.join("m.obj"), obj).unwrap();
+    let plain = renders(&d, scene.as_bytes());
+    std::fs::write(d.join("m.obj"), format!("\u{FEFF}{obj}")).unwrap();
+    assert_eq!(renders(&d, scene.as_bytes()), plain);
+    // A scene file with the mark loads the same, and its first line's columns start after it.
+    assert_eq!(renders(&d, format!("\u{FEFF}{scene}").as_bytes()), plain);
+    let err = fails(&d, "\u{FEFF}zoom = 1\n");
+    says(&err, &d.join("scene.toml"), 1, 1, &["unknown key `zoom`"]);
+    assert!(err.contains("\n 1 | zoom = 1\n   | ^"), "{err}");
+    // An error in the OBJ's first line is at its first character too.
+    std::fs::write(d.join("m.obj"), "\u{FEFF}v 0 x 0\n").unwrap();
+    let err = fails(&d, &scene);
+    says(&err, &d.join("m.obj"), 1, 5, &["`x` is not a number"]);
+}
+
+/// The character of the shown line that the caret under it points at.
+fn under_caret(err: &str) -> char {
+    let lines: Vec<&str> = err.lines().collect();
+    let caret = lines
+        .iter()
+        .rposition(|l| l.ends_with('^'))
+        .expect("a caret line");
+    let at = |l: &str| l.split_once(" | ").map(|(_, rest)| rest.to_string());
+    let shown = at(lines[caret - 1]).expect("a shown line");
+    let column = at(lines[caret]).expect("a caret").chars().count();
+    shown
+        .chars()
+        .nth(column - 1)
+        .expect("the caret is within the line")
+}
+
+#[test]
+fn columns_count_characters_in_meshes_as_in_scene_files() {
+    let d = dir("columns");
+    // "é" is two bytes and "→" three: the bad index is the 11th character (the 14th byte), and
+    // the caret is under it.
+    std::fs::write(d.join("m.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/é 2/→ 9\n").unwrap();
+    let err = fails(
+        &d,
+        &format!("{BASE}[[object]]\nkind = \"obj\"\nmaterial = \"white\"\npath = \"m.obj\"\n"),
+    );
+    says(&err, &d.join("m.obj"), 4, 11, &["vertex index 9"]);
+    assert!(err.contains("\n 4 | f 1/é 2/→ 9\n"), "{err}");
+    assert_eq!(under_caret(&err), '9', "{err}");
+    // The same in a scene file: the column of the value after a non-ASCII key.
+    let err = fails(&d, "[camera]\n\"é→\" = 1\n");
+    says(&err, &d.join("scene.toml"), 2, 1, &["unknown key `é→`"]);
+    let err = fails(
+        &d,
+        "object = [{ material = \"é→\", kind = \"x\", triangles = 1 }]\n",
+    );
+    says(&err, &d.join("scene.toml"), 1, 54, &[]);
+    assert_eq!(under_caret(&err), '1', "{err}");
+}

@@ -11,8 +11,8 @@ fn load(name: &str) -> Scene {
 
 /// The stats of one frame at the scene's own effects (the default stage).
 fn stats(scene: &Scene, lights: &[raytty::PointLight]) -> FrameStats {
-    let settings = Stage::Indirect.settings(scene.effects);
-    render(scene, &scene.camera, lights, &settings, 64, 48).stats
+    let settings = Stage::Indirect.settings(scene.effects());
+    render(scene, &scene.camera(), lights, &settings, 64, 48).stats
 }
 
 #[test]
@@ -20,7 +20,7 @@ fn scenes_without_mirrors_trace_no_reflection_rays() {
     for name in ["cornell", "lights"] {
         let scene = load(name);
         assert!(!scene.has_mirrors());
-        let s = stats(&scene, &scene.lights);
+        let s = stats(&scene, scene.lights());
         assert_eq!(s.rays.reflection, 0, "{name}");
         assert!(s.rays.shadow > 0, "{name}");
     }
@@ -30,7 +30,7 @@ fn scenes_without_mirrors_trace_no_reflection_rays() {
 fn the_mirror_scene_traces_reflection_rays() {
     let scene = load("mirror");
     assert!(scene.has_mirrors());
-    let s = stats(&scene, &scene.lights);
+    let s = stats(&scene, scene.lights());
     // The tall block covers a good part of the view: about 190 of the 3072 pixels.
     assert!(s.rays.reflection > 100, "{:?}", s.rays);
 }
@@ -38,19 +38,19 @@ fn the_mirror_scene_traces_reflection_rays() {
 #[test]
 fn the_lights_scene_traces_shadow_rays_per_light() {
     let scene = load("lights");
-    assert_eq!(scene.lights.len(), 3);
-    let all = stats(&scene, &scene.lights);
+    assert_eq!(scene.lights().len(), 3);
+    let all = stats(&scene, scene.lights());
     // Each light's shadow rays are decided on their own: the three lights together trace
     // exactly what each one traces alone, summed.
     let alone: u64 = scene
-        .lights
+        .lights()
         .iter()
         .map(|l| stats(&scene, std::slice::from_ref(l)).rays.shadow)
         .sum();
     assert_eq!(all.rays.shadow, alone);
     // Nearly every visible point faces all three lights: close to 3 per pixel that shows the
     // scene (the 64×48 view is wider than the box: some pixels see nothing).
-    let rays = scene.camera.rays(64, 48);
+    let rays = scene.camera().rays(64, 48);
     let hits = (0..48)
         .flat_map(|y| (0..64).map(move |x| (x, y)))
         .filter(|&(x, y)| {
@@ -70,11 +70,11 @@ fn the_example_file_loads_with_every_kind_of_object() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/example.toml");
     let scene = file::load(std::path::Path::new(path)).unwrap();
     // Two floor triangles, two boxes, the tetrahedron, and a k = 8 icosphere.
-    assert_eq!(scene.triangles.len(), 2 + 12 + 12 + 4 + 20 * 64);
-    assert_eq!(scene.name, "example");
-    assert_eq!(scene.lights.len(), 2);
+    assert_eq!(scene.triangles().len(), 2 + 12 + 12 + 4 + 20 * 64);
+    assert_eq!(scene.name(), "example");
+    assert_eq!(scene.lights().len(), 2);
     assert!(scene.has_mirrors());
-    let s = stats(&scene, &scene.lights);
+    let s = stats(&scene, scene.lights());
     assert!(s.rays.reflection > 0);
 }
 
@@ -88,7 +88,7 @@ fn transforms_scale_then_rotate_then_translate() {
     )
     .unwrap();
     let (mut lo, mut hi) = (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN));
-    for v in scene.triangles.iter().flat_map(|t| t.v) {
+    for v in scene.triangles().iter().flat_map(|t| t.v) {
         lo = lo.min(v);
         hi = hi.max(v);
     }
@@ -96,7 +96,7 @@ fn transforms_scale_then_rotate_then_translate() {
     let close = |a: glam::Vec3, b: glam::Vec3| (a - b).abs().max_element() < 1e-5;
     assert!(close(lo, glam::Vec3::new(10.0, 0.0, -2.0)), "{lo}");
     assert!(close(hi, glam::Vec3::new(14.0, 2.0, 0.0)), "{hi}");
-    assert_eq!(scene.name, "t");
+    assert_eq!(scene.name(), "t");
 }
 
 #[test]
@@ -109,8 +109,8 @@ fn the_scene_name_comes_from_the_file_and_keeps_its_characters() {
     )
     .unwrap();
     // The scene keeps the name as written; the app shows it through `printable`.
-    assert_eq!(scene.name, "box\x1b[2J");
-    assert_eq!(raytty::printable(&scene.name), "box[2J");
+    assert_eq!(scene.name(), "box\x1b[2J");
+    assert_eq!(raytty::printable(scene.name()), "box[2J");
 }
 
 /// The million-triangle scene loads (the mesh generated, the BVH built) and renders: it is the
@@ -119,9 +119,9 @@ fn the_scene_name_comes_from_the_file_and_keeps_its_characters() {
 fn the_large_mesh_scene_loads_and_renders() {
     let b = builtin::find("sphere").unwrap();
     let scene = b.load().unwrap();
-    assert_eq!(scene.triangles.len(), b.triangles);
-    assert!(scene.triangles.len() > 1_000_000);
-    let s = stats(&scene, &scene.lights);
+    assert_eq!(scene.triangles().len(), b.triangles);
+    assert!(scene.triangles().len() > 1_000_000);
+    let s = stats(&scene, scene.lights());
     assert_eq!(s.rays.primary, 64 * 48);
     assert_eq!(s.rays.reflection, 0);
     assert!(s.rays.shadow > 0);

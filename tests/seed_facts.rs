@@ -17,8 +17,8 @@ fn check(dir: Vec3, point: Vec3, colour: Vec3) -> f32 {
     );
     let tracer = Tracer::new(
         &scene,
-        &scene.lights,
-        Stage::Indirect.settings(scene.effects),
+        scene.lights(),
+        Stage::Indirect.settings(scene.effects()),
     );
     let mut counts = RayCounts::default();
     let c = tracer.shade_primary(&ray, Some(hit), &mut Rng::seeded(0), &mut counts);
@@ -62,8 +62,8 @@ fn downward_ray_hits_the_floor() {
     assert!((p.y - 1.0).abs() < 1e-5, "on the floor: {p}");
     let tracer = Tracer::new(
         &scene,
-        &scene.lights,
-        Stage::Indirect.settings(scene.effects),
+        scene.lights(),
+        Stage::Indirect.settings(scene.effects()),
     );
     let c = tracer.shade_primary(
         &ray,

@@ -254,9 +254,9 @@ fn kernels_match_the_scalar_test_on_soups_from_1e_minus_15_to_2e38() {
 #[test]
 fn kernels_match_on_the_cornell_box_camera_and_shadow_rays() {
     let scene = cornell_box();
-    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let cam = scene.camera.rays(100, 100);
-    let light = scene.lights[0].position;
+    let tris: Vec<[Vec3; 3]> = scene.triangles().iter().map(|t| t.v).collect();
+    let cam = scene.camera().rays(100, 100);
+    let light = scene.lights()[0].position;
     let mut rays = vec![];
     for y in 0..100 {
         for x in 0..100 {
@@ -295,9 +295,9 @@ fn structures_on_every_path_match_brute_force() {
 fn cornell_frames_are_identical_on_every_path() {
     let scene = cornell_box();
     for stage in Stage::ALL {
-        let settings = stage.settings(scene.effects);
+        let settings = stage.settings(scene.effects());
         let frame = |s: &Scene| {
-            let f = render(s, &s.camera, &s.lights, &settings, 96, 64);
+            let f = render(s, &s.camera(), s.lights(), &settings, 96, 64);
             let bits: Vec<u32> = f
                 .image
                 .pixels

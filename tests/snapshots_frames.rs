@@ -5,8 +5,8 @@ use raytty::{CellGrid, ColorMode, Stage, cornell_box, encode_text, render};
 
 fn frame(stage: Stage, mode: ColorMode) -> String {
     let scene = cornell_box();
-    let settings = stage.settings(scene.effects);
-    let f = render(&scene, &scene.camera, &scene.lights, &settings, 80, 48);
+    let settings = stage.settings(scene.effects());
+    let f = render(&scene, &scene.camera(), scene.lights(), &settings, 80, 48);
     String::from_utf8(encode_text(&CellGrid::from_image(&f.image, mode))).unwrap()
 }
 

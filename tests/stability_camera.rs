@@ -60,15 +60,15 @@ fn cameras(short_block_centre: Vec3) -> Vec<(String, Camera)> {
 #[test]
 fn awkward_cameras_give_finite_images_in_every_stage() {
     let scene = cornell_box();
-    let centre = scene.triangles[10..20]
+    let centre = scene.triangles()[10..20]
         .iter()
         .flat_map(|t| t.v)
         .sum::<Vec3>()
         / 30.0;
     for (name, camera) in cameras(centre) {
         for stage in Stage::ALL {
-            let settings = stage.settings(scene.effects);
-            let frame = render(&scene, &camera, &scene.lights, &settings, SIZE.0, SIZE.1);
+            let settings = stage.settings(scene.effects());
+            let frame = render(&scene, &camera, scene.lights(), &settings, SIZE.0, SIZE.1);
             if let Some(k) = frame
                 .image
                 .pixels
@@ -92,7 +92,7 @@ fn a_camera_inside_a_closed_object_sees_only_its_inside() {
     // From inside the short block every primary ray hits the block (it is closed by the
     // floor), so no pixel shows the background.
     let scene = cornell_box();
-    let centre = scene.triangles[10..20]
+    let centre = scene.triangles()[10..20]
         .iter()
         .flat_map(|t| t.v)
         .sum::<Vec3>()
@@ -102,8 +102,8 @@ fn a_camera_inside_a_closed_object_sees_only_its_inside() {
         yaw: 0.3,
         pitch: 0.2,
     };
-    let settings = Stage::Flat.settings(scene.effects);
-    let frame = render(&scene, &camera, &scene.lights, &settings, SIZE.0, SIZE.1);
+    let settings = Stage::Flat.settings(scene.effects());
+    let frame = render(&scene, &camera, scene.lights(), &settings, SIZE.0, SIZE.1);
     let background = frame
         .image
         .pixels

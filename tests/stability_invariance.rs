@@ -26,21 +26,22 @@ const TRANSLATED_EDGE_TOL: f64 = 4.0 / 1024.0;
 fn moved(base: &Scene, s: f32, offset: Vec3) -> (Scene, Camera, Vec<PointLight>) {
     let map = |p: Vec3| p * s + offset;
     let mut b = SceneBuilder::new();
-    for m in &base.materials {
+    for m in base.materials() {
         b.material(m.clone());
     }
     // One object per run of triangles with the same material (objects only affect culling).
     let mut start = 0;
-    for i in 1..=base.triangles.len() {
-        if i == base.triangles.len() || base.triangles[i].material != base.triangles[start].material
+    for i in 1..=base.triangles().len() {
+        if i == base.triangles().len()
+            || base.triangles()[i].material != base.triangles()[start].material
         {
-            let run = &base.triangles[start..i];
+            let run = &base.triangles()[start..i];
             b.object(run.iter().map(|t| t.v.map(map)), run[0].material);
             start = i;
         }
     }
     let lights: Vec<PointLight> = base
-        .lights
+        .lights()
         .iter()
         .map(|l| PointLight {
             position: map(l.position),
@@ -48,17 +49,17 @@ fn moved(base: &Scene, s: f32, offset: Vec3) -> (Scene, Camera, Vec<PointLight>)
         })
         .collect();
     let camera = Camera {
-        position: map(base.camera.position),
-        ..base.camera
+        position: map(base.camera().position),
+        ..base.camera()
     };
     let scene = b
-        .build("moved", camera, base.effects)
+        .build("moved", camera, base.effects())
         .expect("a moved Cornell box is valid");
     (scene, camera, lights)
 }
 
 fn image(scene: &Scene, camera: &Camera, lights: &[PointLight]) -> Vec<[u8; 3]> {
-    let settings = Stage::Indirect.settings(scene.effects);
+    let settings = Stage::Indirect.settings(scene.effects());
     render(scene, camera, lights, &settings, SIZE.0, SIZE.1)
         .image
         .to_rgb8()
@@ -66,14 +67,14 @@ fn image(scene: &Scene, camera: &Camera, lights: &[PointLight]) -> Vec<[u8; 3]> 
 
 fn check(name: &str, s: f32, offset: Vec3, tol: f64) {
     let base = cornell_box();
-    let want = image(&base, &base.camera, &base.lights);
+    let want = image(&base, &base.camera(), base.lights());
     let (scene, camera, lights) = moved(&base, s, offset);
     let got = image(&scene, &camera, &lights);
     let reference = Reference::new(&base);
     let mask = reference.frame(
-        &base.camera.rays(SIZE.0, SIZE.1),
+        &base.camera().rays(SIZE.0, SIZE.1),
         SIZE,
-        &base.lights,
+        base.lights(),
         true,
         0.5,
         tol,

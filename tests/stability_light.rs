@@ -39,8 +39,8 @@ fn cap(scene: &Scene, light: &PointLight) -> f32 {
 }
 
 fn awkward_places(scene: &Scene) -> Vec<(&'static str, Vec3)> {
-    let short = &scene.triangles[10..20];
-    let tall = &scene.triangles[20..30];
+    let short = &scene.triangles()[10..20];
+    let tall = &scene.triangles()[20..30];
     // The short block's first triangle is [E, B, A]: E is a top corner, E–A a vertical edge.
     let [e, _, a] = short[0].v;
     let centre = tall.iter().flat_map(|t| t.v).sum::<Vec3>() / 30.0;
@@ -52,7 +52,7 @@ fn awkward_places(scene: &Scene) -> Vec<(&'static str, Vec3)> {
         ("on a block's vertex", e),
         ("on a block's edge", e.lerp(a, 0.5)),
         ("inside a block", centre),
-        ("at the camera", scene.camera.position),
+        ("at the camera", scene.camera().position),
     ]
 }
 
@@ -62,12 +62,12 @@ fn awkward_lights_give_finite_pixels_within_the_cap() {
     for (name, position) in awkward_places(&scene) {
         let lights = [PointLight {
             position,
-            ..scene.lights[0]
+            ..scene.lights()[0]
         }];
         let cap = cap(&scene, &lights[0]);
         for stage in LIT {
-            let settings = stage.settings(scene.effects);
-            let frame = render(&scene, &scene.camera, &lights, &settings, SIZE.0, SIZE.1);
+            let settings = stage.settings(scene.effects());
+            let frame = render(&scene, &scene.camera(), &lights, &settings, SIZE.0, SIZE.1);
             for (k, p) in frame.image.pixels.iter().enumerate() {
                 let (x, y) = (k as u32 % SIZE.0, k as u32 / SIZE.0);
                 assert!(
@@ -90,20 +90,20 @@ fn awkward_lights_give_finite_pixels_within_the_cap() {
 fn light_approaching_a_surface_follows_the_r_to_zero_rule() {
     let scene = cornell_box();
     // A point on the tall block's front face, seen by the centre camera ray.
-    let ray = Ray::new(scene.camera.position, Vec3::Z);
+    let ray = Ray::new(scene.camera().position, Vec3::Z);
     let hit = scene
         .intersect(&ray, f32::INFINITY)
         .expect("centre ray hits");
-    let tri = &scene.triangles[hit.triangle as usize];
+    let tri = &scene.triangles()[hit.triangle as usize];
     let (p, err) = hit_point(&tri.v, hit.b);
     let n = if tri.normal.dot(ray.dir) > 0.0 {
         -tri.normal
     } else {
         tri.normal
     };
-    let power = scene.lights[0].power;
+    let power = scene.lights()[0].power;
     let r_min = scene.min_light_distance();
-    let settings = Stage::Shadows.settings(scene.effects);
+    let settings = Stage::Shadows.settings(scene.effects());
     for k in 0..=10 {
         let r = 10f32.powi(-k);
         for (side, expect_light) in [(1.0, true), (-1.0, false)] {

@@ -17,14 +17,21 @@ const LEVEL: f64 = 1.0 / 255.0;
 fn indirect_frame_matches_the_f64_reference_within_one_level() {
     let scene = cornell_box();
     let (w, h) = (500, 500);
-    let settings = Stage::Indirect.settings(scene.effects);
+    let settings = Stage::Indirect.settings(scene.effects());
     let Indirect::Constant(ambient) = settings.effects.indirect else {
         panic!("the Cornell box's indirect stage is the seed's constant term");
     };
-    let frame = render(&scene, &scene.camera, &scene.lights, &settings, w, h);
+    let frame = render(&scene, &scene.camera(), scene.lights(), &settings, w, h);
     let reference = Reference::new(&scene);
-    let rays = scene.camera.rays(w, h);
-    let pixels = reference.frame(&rays, (w, h), &scene.lights, true, ambient as f64, EDGE_TOL);
+    let rays = scene.camera().rays(w, h);
+    let pixels = reference.frame(
+        &rays,
+        (w, h),
+        scene.lights(),
+        true,
+        ambient as f64,
+        EDGE_TOL,
+    );
     let mut masked = 0;
     let mut masked_off = 0;
     let mut worst = 0.0f64;

@@ -22,11 +22,11 @@ const RAYS_PER_TRIANGLE: u32 = 100;
 fn default_view_has_no_pixel_wrongly_in_shadow_or_wrongly_lit() {
     let scene = cornell_box();
     let (w, h) = (500, 500);
-    let settings = Stage::Shadows.settings(scene.effects);
-    let frame = render(&scene, &scene.camera, &scene.lights, &settings, w, h);
+    let settings = Stage::Shadows.settings(scene.effects());
+    let frame = render(&scene, &scene.camera(), scene.lights(), &settings, w, h);
     let reference = Reference::new(&scene);
-    let rays = scene.camera.rays(w, h);
-    let pixels = reference.frame(&rays, (w, h), &scene.lights, true, 0.0, EDGE_TOL);
+    let rays = scene.camera().rays(w, h);
+    let pixels = reference.frame(&rays, (w, h), scene.lights(), true, 0.0, EDGE_TOL);
     let (mut masked, mut wrongly_dark, mut wrongly_lit) = (0, Vec::new(), Vec::new());
     // Disagreements inside the mask: what the test would report without it.
     let (mut masked_dark, mut masked_lit) = (Vec::new(), Vec::new());

@@ -77,7 +77,7 @@ fn triangles(verts: &[Vec3], faces: &[[usize; 3]]) -> Vec<[Vec3; 3]> {
 /// The eight corners A..H of a Cornell block, read back from its ten triangles (the seed's
 /// order: `[E,B,A], [E,F,B], [F,D,B], [F,H,D], [H,C,D], [H,G,C], ...`).
 fn block_corners(scene: &Scene, first: usize) -> [Vec3; 8] {
-    let t = |i: usize| scene.triangles[first + i].v;
+    let t = |i: usize| scene.triangles()[first + i].v;
     let (e, b, a) = (t(0)[0], t(0)[1], t(0)[2]);
     let (f, d) = (t(2)[0], t(2)[1]);
     let (h, c) = (t(4)[0], t(4)[1]);
@@ -88,7 +88,7 @@ fn block_corners(scene: &Scene, first: usize) -> [Vec3; 8] {
 /// A Cornell block closed with a bottom (the seed leaves it open; it stands on the floor).
 fn closed_block(scene: &Scene, first: usize) -> Vec<[Vec3; 3]> {
     let [a, b, c, d, ..] = block_corners(scene, first);
-    let mut tris: Vec<[Vec3; 3]> = (0..10).map(|i| scene.triangles[first + i].v).collect();
+    let mut tris: Vec<[Vec3; 3]> = (0..10).map(|i| scene.triangles()[first + i].v).collect();
     tris.push([a, b, d]);
     tris.push([a, d, c]);
     tris

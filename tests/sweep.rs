@@ -22,7 +22,7 @@ fn light_position(rng: &mut Rng, kind: u32) -> Vec3 {
         ),
         1 => {
             // Inside a block: a random point inside the convex hull of one block's corners.
-            let block = &scene.triangles[10 + 10 * (rng.next_u64() % 2) as usize..][..10];
+            let block = &scene.triangles()[10 + 10 * (rng.next_u64() % 2) as usize..][..10];
             let corners: Vec<Vec3> = block.iter().flat_map(|t| t.v).collect();
             let w: Vec<f32> = corners.iter().map(|_| rng.next_f32()).collect();
             let sum: f32 = w.iter().sum();
@@ -30,7 +30,7 @@ fn light_position(rng: &mut Rng, kind: u32) -> Vec3 {
         }
         2 => {
             // On a surface: a random point of a random triangle.
-            let t = &scene.triangles[(rng.next_u64() % scene.triangles.len() as u64) as usize];
+            let t = &scene.triangles()[(rng.next_u64() % scene.triangles().len() as u64) as usize];
             let (mut a, mut b) = (rng.next_f32(), rng.next_f32());
             if a + b > 1.0 {
                 (a, b) = (1.0 - a, 1.0 - b);
@@ -39,7 +39,7 @@ fn light_position(rng: &mut Rng, kind: u32) -> Vec3 {
         }
         _ => {
             // Exactly on a wall plane or a vertex.
-            let t = &scene.triangles[(rng.next_u64() % scene.triangles.len() as u64) as usize];
+            let t = &scene.triangles()[(rng.next_u64() % scene.triangles().len() as u64) as usize];
             t.v[(rng.next_u64() % 3) as usize]
         }
     }
@@ -65,10 +65,10 @@ fn random_poses_give_finite_in_range_images() {
         };
         let light = PointLight {
             position: light_position(&mut rng, i),
-            ..scene.lights[0]
+            ..scene.lights()[0]
         };
         let stage = Stage::ALL[(i % 6) as usize];
-        let settings = stage.settings(scene.effects);
+        let settings = stage.settings(scene.effects());
         let frame = render(&scene, &camera, &[light], &settings, 32, 24);
         for (p, px) in frame.image.pixels.iter().enumerate() {
             assert!(

@@ -4,6 +4,8 @@
 
 use std::io::{Read, Write};
 use std::num::NonZeroU16;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant};
 
@@ -17,8 +19,10 @@ use raytty::{CellGrid, ColorMode, Stage, cornell_box, render};
 const TIMEOUT: Duration = Duration::from_secs(30);
 /// How soon the app must exit once its pty is closed, or on a signal.
 const EXIT_WITHIN: Duration = Duration::from_secs(5);
-/// Between checks of whether the child has exited.
+/// Between checks of whether the child has exited, or of a paused reader whether to go on.
 const EXIT_POLL: Duration = Duration::from_millis(20);
+/// The bound: after a signal the app is gone within this, even on a stalled link.
+const EXIT_AFTER_SIGNAL: Duration = Duration::from_secs(2);
 
 struct Session {
     child: Box<dyn Child + Send + Sync>,
@@ -26,6 +30,10 @@ struct Session {
     writer: Option<Box<dyn Write + Send>>,
     output: Receiver<Vec<u8>>,
     screen: vt100::Parser,
+    /// Every byte the app wrote that the test has processed.
+    raw: Vec<u8>,
+    /// While set, the reader stops reading (a stalled link: the app's writes fill the pty).
+    paused: Arc<AtomicBool>,
 }
 
 impl Session {
@@ -66,10 +74,18 @@ impl Session {
         let mut reader = pair.master.try_clone_reader().expect("pty reader");
         let writer = pair.master.take_writer().expect("pty writer");
         let (tx, output) = mpsc::channel();
+        let paused = Arc::new(AtomicBool::new(false));
+        let pause = paused.clone();
         std::thread::spawn(move || {
             let mut buf = [0u8; 65536];
             let mut seen = Vec::new();
-            while let Ok(n @ 1..) = reader.read(&mut buf) {
+            loop {
+                while pause.load(Ordering::SeqCst) {
+                    std::thread::sleep(EXIT_POLL);
+                }
+                let Ok(n @ 1..) = reader.read(&mut buf) else {
+                    break;
+                };
                 if tx.send(buf[..n].to_vec()).is_err() {
                     break;
                 }
@@ -87,7 +103,14 @@ impl Session {
             writer: Some(writer),
             output,
             screen: vt100::Parser::new(nonzero(rows), nonzero(cols), 0),
+            raw: Vec::new(),
+            paused,
         }
+    }
+
+    fn process(&mut self, bytes: &[u8]) {
+        self.screen.process(bytes);
+        self.raw.extend_from_slice(bytes);
     }
 
     /// Reads output until `cond` holds for the screen; fails with the screen if it never does.
@@ -96,7 +119,7 @@ impl Session {
         while !cond(self.screen.screen()) {
             let left = deadline.saturating_duration_since(Instant::now());
             match self.output.recv_timeout(left) {
-                Ok(bytes) => self.screen.process(&bytes),
+                Ok(bytes) => self.process(&bytes),
                 Err(_) => panic!(
                     "timed out waiting for {what}; the screen shows:\n{}",
                     self.screen.screen().contents()
@@ -127,7 +150,7 @@ impl Session {
         loop {
             let left = deadline.saturating_duration_since(Instant::now());
             match self.output.recv_timeout(left) {
-                Ok(bytes) => self.screen.process(&bytes),
+                Ok(bytes) => self.process(&bytes),
                 Err(mpsc::RecvTimeoutError::Disconnected) => break,
                 Err(mpsc::RecvTimeoutError::Timeout) => panic!("the app did not exit"),
             }
@@ -164,11 +187,11 @@ impl Drop for Session {
 /// of image (the status line is not included).
 fn expected(cols: u16, rows: u16, camera_z: f32, light_y: f32) -> CellGrid {
     let scene = cornell_box();
-    let mut camera = scene.camera;
+    let mut camera = scene.camera();
     camera.position += camera.forward() * camera_z;
-    let mut lights = scene.lights.clone();
+    let mut lights = scene.lights().to_vec();
     lights[0].position += camera.to_world(Vec3::new(0.0, light_y, 0.0));
-    let settings = Stage::Indirect.settings(scene.effects);
+    let settings = Stage::Indirect.settings(scene.effects());
     let frame = render(
         &scene,
         &camera,
@@ -191,19 +214,41 @@ fn rgb(c: vt100::Color) -> Option<Colour> {
     }
 }
 
-/// Whether the screen's image rows show exactly `grid` (character, background, and the
-/// foreground of half-blocks).
+/// The (upper, lower) pixel colours a block-drawing cell shows, whichever of the
+/// equivalent ways it was drawn (`▀` or `▄` with the colours swapped, a space or a full block);
+/// `None` for any other character.
+fn pixels(
+    ch: char,
+    fg: Option<Colour>,
+    bg: Option<Colour>,
+) -> Option<(Option<Colour>, Option<Colour>)> {
+    match ch {
+        '▀' => Some((fg, bg)),
+        '▄' => Some((bg, fg)),
+        '█' => Some((fg, fg)),
+        ' ' => Some((bg, bg)),
+        _ => None,
+    }
+}
+
+/// The pixels the terminal shows at (row, col), if the cell is a block-drawing one.
+fn shown_pixels(
+    screen: &vt100::Screen,
+    r: u16,
+    c: u16,
+) -> Option<(Option<Colour>, Option<Colour>)> {
+    let got = screen.cell(r, c)?;
+    let ch = got.contents().chars().next().unwrap_or(' ');
+    pixels(ch, rgb(got.fgcolor()), rgb(got.bgcolor()))
+}
+
+/// Whether the screen's image rows show exactly `grid`: the same two pixels in every cell.
 fn shows(screen: &vt100::Screen, grid: &CellGrid) -> bool {
     (0..grid.rows).all(|r| {
         (0..grid.cols).all(|c| {
             let want = grid.get(c, r);
-            let Some(got) = screen.cell(r as u16, c as u16) else {
-                return false;
-            };
-            let ch = got.contents().chars().next().unwrap_or(' ');
-            ch == want.ch
-                && rgb(got.bgcolor()) == want.bg
-                && (want.fg.is_none() || rgb(got.fgcolor()) == want.fg)
+            let want = pixels(want.ch, want.fg, want.bg);
+            want.is_some() && shown_pixels(screen, r as u16, c as u16) == want
         })
     })
 }
@@ -218,8 +263,8 @@ fn the_first_frame_shows_the_box_in_truecolor_half_blocks() {
     assert!(screen.alternate_screen() && screen.hide_cursor());
     // The seed's walls, purple on the left and yellow on the right, as the terminal shows them:
     // the box's front opening spans the 24-pixel-high image's middle 24 columns (48-71).
-    let left = rgb(screen.cell(6, 50).unwrap().bgcolor());
-    let right = rgb(screen.cell(6, 69).unwrap().bgcolor());
+    let left = shown_pixels(screen, 6, 50).unwrap().1;
+    let right = shown_pixels(screen, 6, 69).unwrap().1;
     assert!(
         matches!(left, Some(Colour::Rgb(r, g, b)) if r as u16 > 2 * g as u16 && b as u16 > 2 * g as u16),
         "{left:?}"
@@ -425,4 +470,134 @@ fn ctrl_z_gives_the_terminal_back_and_continuing_redraws() {
     s.wait_for_status(&["indirect"]);
     s.send(b"\x1b");
     assert!(s.finish().success());
+}
+
+#[test]
+fn an_arrow_split_across_reads_moves_the_camera_and_does_not_quit() {
+    let mut s = Session::start(120, 10, false);
+    s.wait_for_status(&["cam 0.00,0.00,-3.00"]);
+    // A slow or choppy link delivers the three bytes of Up apart; these gaps are the input
+    // under test, not waits (the app's ESC delay is tens of milliseconds).
+    for part in [&b"\x1b"[..], b"[", b"A"] {
+        s.send(part);
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    s.wait_for_status(&["cam 0.00,0.00,-2.90"]);
+    assert!(s.child.try_wait().expect("query the child").is_none());
+    // A lone Esc still quits, once nothing follows it.
+    s.send(b"\x1b");
+    assert!(s.finish().success());
+}
+
+/// The master's unread bytes: when they stop being read, the app's writes fill the pty.
+#[cfg(target_os = "linux")]
+fn unread(master: &dyn MasterPty) -> usize {
+    let fd = master.as_raw_fd().expect("a unix pty");
+    let mut n: libc::c_int = 0;
+    // SAFETY: FIONREAD stores an int.
+    unsafe { libc::ioctl(fd, libc::FIONREAD, &mut n) };
+    n as usize
+}
+
+#[test]
+#[cfg(target_os = "linux")]
+fn a_signal_ends_the_app_in_time_and_restores_even_when_the_link_is_stalled() {
+    for (sig, name) in [
+        (libc::SIGTERM, "TERM"),
+        (libc::SIGINT, "INT"),
+        (libc::SIGHUP, "HUP"),
+    ] {
+        let mut s = Session::start(300, 100, false);
+        s.wait_for_status(&["indirect"]);
+        // The terminal stops reading (a stalled SSH connection) while keys keep coming.
+        s.paused.store(true, Ordering::SeqCst);
+        s.send(&[b'd'; 200]);
+        let deadline = Instant::now() + TIMEOUT;
+        // The app writes a new frame into the pty until it is full (a full 300x100 frame is
+        // far larger than the pty holds).
+        while unread(s.master.as_deref().unwrap()) < 4000 {
+            assert!(
+                Instant::now() < deadline,
+                "SIG{name}: the app wrote no new frame"
+            );
+            std::thread::sleep(EXIT_POLL);
+        }
+        let pid = s.child.process_id().expect("pid");
+        let killed = std::process::Command::new("kill")
+            .args([&format!("-{name}"), &pid.to_string()])
+            .status()
+            .expect("run kill");
+        assert!(killed.success());
+        let status = s.wait_exit(EXIT_AFTER_SIGNAL);
+        assert_eq!(status.exit_code(), 128 + sig as u32, "SIG{name}");
+        // Cooked mode again, although the terminal has read nothing since.
+        let termios = s.master.as_ref().unwrap().get_termios().expect("termios");
+        let local = termios.local_flags.bits() as libc::tcflag_t;
+        assert!(
+            local & libc::ICANON != 0 && local & libc::ECHO != 0,
+            "SIG{name}: still in raw mode"
+        );
+        // Once the link resumes, the screen is the shell's again.
+        s.paused.store(false, Ordering::SeqCst);
+        drop(s.writer.take());
+        drop(s.master.take());
+        s.finish();
+        let screen = s.screen.screen();
+        assert!(
+            !screen.alternate_screen() && !screen.hide_cursor(),
+            "SIG{name}: the terminal was not restored"
+        );
+    }
+}
+
+/// A scene file in the temporary directory named `name`; removed when dropped.
+struct SceneFile(std::path::PathBuf);
+
+impl SceneFile {
+    fn named(name: &str, tag: &str) -> SceneFile {
+        let path = std::env::temp_dir().join(format!("raytty-{tag}-{}.toml", std::process::id()));
+        let source = format!(
+            "name = \"{name}\"\n[material.m]\ncolour = [1, 1, 1]\n[[object]]\nkind = \"box\"\nmaterial = \"m\"\ncentre = [0, 0, 0]\nsize = [1, 1, 1]\n"
+        );
+        std::fs::write(&path, source).expect("write a scene file");
+        SceneFile(path)
+    }
+
+    fn path(&self) -> &str {
+        self.0.to_str().expect("a UTF-8 temporary path")
+    }
+}
+
+impl Drop for SceneFile {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+#[test]
+fn wide_and_bidi_scene_names_keep_the_status_line_on_one_row() {
+    let wide = SceneFile::named(&"漢".repeat(200), "wide");
+    let mut s = Session::start_with(80, 12, false, &["--scene", wide.path()]);
+    s.wait_for_status(&["漢漢漢"]);
+    let screen = s.screen.screen();
+    let above = screen.contents_between(10, 0, 10, 80);
+    assert!(!above.contains('漢'), "the status line wrapped: {above:?}");
+    // The row above the status line is still the image: block cells with colours.
+    assert!(shown_pixels(screen, 10, 40).is_some_and(|(up, lo)| up.is_some() && lo.is_some()));
+    s.send(b"\x1b");
+    assert!(s.finish().success());
+
+    let bidi = SceneFile::named("evil\u{202e}box\u{2066}x\u{200b}", "bidi");
+    let mut s = Session::start_with(80, 12, false, &["--scene", bidi.path()]);
+    s.wait_for_status(&["evilboxx"]);
+    s.send(b"\x1b");
+    assert!(s.finish().success());
+    for c in ['\u{202e}', '\u{2066}', '\u{200b}'] {
+        let mut utf8 = [0; 4];
+        let bytes = c.encode_utf8(&mut utf8).as_bytes();
+        assert!(
+            !s.raw.windows(bytes.len()).any(|w| w == bytes),
+            "{c:?} reached the terminal"
+        );
+    }
 }

@@ -5,11 +5,22 @@ use std::fmt;
 use std::io::{self, Write};
 use std::path::PathBuf;
 
-use super::{BenchOptions, csv, markdown, rewrite_readme, run, svg};
+use super::{BenchOptions, Progress, csv, markdown, rewrite_readme, run, svg};
+use crate::image::MAX_PIXELS;
 use crate::scene::Scene;
 
-/// Most pixels one bench size may have (4096×4096): a bench row renders its size several times.
-pub const MAX_BENCH_PIXELS: u64 = 1 << 24;
+/// Refuses a bench size over [`MAX_PIXELS`], the cap every frame has, with a message that
+/// names the flag.
+pub fn check_sizes(sizes: &[(u32, u32)]) -> Result<(), BenchError> {
+    for &(w, h) in sizes {
+        if u64::from(w) * u64::from(h) > MAX_PIXELS {
+            return Err(BenchError::Usage(format!(
+                "--sizes {w}x{h} is too large: at most {MAX_PIXELS} pixels per size (e.g. 8192x8192)"
+            )));
+        }
+    }
+    Ok(())
+}
 
 /// What the user asked `raytty bench` for. `None` fields take the defaults of
 /// [`BenchOptions::full`], or of [`BenchOptions::quick`] with `quick`.
@@ -98,22 +109,16 @@ fn io_error(what: impl Into<String>) -> impl FnOnce(io::Error) -> BenchError {
 }
 
 /// Runs the bench on `scene`: the table (or CSV) goes to `out`, how each reference was made and
-/// where it is cached to `log`, and the SVG and README to their files.
+/// where it is cached to `log`, progress to `progress`, and the SVG and README to their files.
 pub fn run_command(
     scene: &Scene,
     request: &BenchRequest,
     out: &mut dyn Write,
     log: &mut dyn Write,
+    progress: &mut dyn Progress,
 ) -> Result<(), BenchError> {
     let options = request.options();
-    for &(w, h) in &options.sizes {
-        if u64::from(w) * u64::from(h) > MAX_BENCH_PIXELS {
-            return Err(BenchError::Usage(format!(
-                "--sizes {w}x{h} is too large for a bench: at most {MAX_BENCH_PIXELS} pixels \
-                 per size (e.g. 4096x4096)"
-            )));
-        }
-    }
+    check_sizes(&options.sizes)?;
     // Read the README before the long run, so that a wrong path fails at once.
     let readme = match &request.readme {
         Some(path) => {
@@ -125,7 +130,7 @@ pub fn run_command(
         }
         None => None,
     };
-    let report = run(scene, &options).map_err(io_error(format!(
+    let report = run(scene, &options, progress).map_err(io_error(format!(
         "cannot cache the reference in {}",
         options.cache_dir.display()
     )))?;

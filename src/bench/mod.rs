@@ -8,9 +8,12 @@
 pub mod command;
 pub mod metrics;
 pub mod output;
+pub mod progress;
 pub mod reference;
 pub mod scene;
+pub mod table;
 pub mod throughput;
+pub mod timing;
 
 use std::io;
 use std::path::PathBuf;
@@ -22,9 +25,11 @@ use crate::render::render;
 use crate::scene::{Effects, Indirect, Scene};
 use crate::shading::{Mode, RayCounts, Settings, Stage};
 
-pub use command::{BenchError, BenchRequest, run_command};
+pub use command::{BenchError, BenchRequest, check_sizes, run_command};
 pub use output::{csv, markdown, rewrite_readme, svg};
+pub use progress::{NoProgress, Progress};
 pub use reference::{ReferenceInfo, ReferenceSpec};
+use timing::{Runs, ms};
 
 /// The seed's stages that get a row each (stage 6, GI, has its own rows).
 pub const SEED_STAGES: [Stage; 5] = [
@@ -63,8 +68,6 @@ pub struct BenchOptions {
     pub ref_bounces: u32,
     /// Where references are cached.
     pub cache_dir: PathBuf,
-    /// Show progress bars on stderr (only when it is a terminal).
-    pub progress: bool,
 }
 
 impl BenchOptions {
@@ -79,7 +82,6 @@ impl BenchOptions {
             ref_spp: 1024,
             ref_bounces: 16,
             cache_dir: reference::default_cache_dir(),
-            progress: true,
         }
     }
 
@@ -155,9 +157,9 @@ impl RowKind {
     /// The settings the row renders with.
     pub fn settings(&self, scene: &Scene) -> Settings {
         match *self {
-            RowKind::Stage(s) => s.settings(scene.effects),
+            RowKind::Stage(s) => s.settings(scene.effects()),
             RowKind::Aa { spp } => {
-                let mut s = Stage::Indirect.settings(scene.effects);
+                let mut s = Stage::Indirect.settings(scene.effects());
                 s.effects.samples = spp;
                 s
             }
@@ -245,14 +247,17 @@ pub fn rows_for(options: &BenchOptions) -> Vec<RowKind> {
 }
 
 /// Runs the bench on `scene`: references first (cached), then every row of every size.
-pub fn run(scene: &Scene, options: &BenchOptions) -> io::Result<BenchReport> {
+pub fn run(
+    scene: &Scene,
+    options: &BenchOptions,
+    progress: &mut dyn Progress,
+) -> io::Result<BenchReport> {
     let load_start = load_average();
     let mut references = Vec::new();
     let mut images = Vec::new();
     for &(w, h) in &options.sizes {
         let spec = ReferenceSpec::new(scene, w, h, options.ref_spp, options.ref_bounces);
-        let (img, info) =
-            reference::load_or_render(scene, &spec, &options.cache_dir, options.progress)?;
+        let (img, info) = reference::load_or_render(scene, &spec, &options.cache_dir, progress)?;
         images.push(img);
         references.push(info);
     }
@@ -264,21 +269,21 @@ pub fn run(scene: &Scene, options: &BenchOptions) -> io::Result<BenchReport> {
         .map(|k| k.weight() * u64::from(runs + 1))
         .sum::<u64>()
         * options.sizes.len() as u64;
-    let bar = reference::progress_bar(total, "bench", options.progress);
+    progress.start("bench", total, 0);
     let mut rows = Vec::new();
     for (&(w, h), reference) in options.sizes.iter().zip(&images) {
         for kind in &kinds {
-            bar.set_message(format!(
+            progress.message(&format!(
                 "{w}x{h} {} {}spp",
                 kind.label().split(' ').next().unwrap_or(""),
                 kind.spp()
             ));
             rows.push(measure(scene, *kind, w, h, options, reference, || {
-                bar.inc(kind.weight())
+                progress.advance(kind.weight())
             }));
         }
     }
-    bar.finish_and_clear();
+    progress.finish();
     let load_end = load_average();
     Ok(BenchReport {
         rows,
@@ -300,49 +305,50 @@ fn measure(
     height: u32,
     options: &BenchOptions,
     reference: &Image,
-    mut tick: impl FnMut(),
+    tick: impl FnMut(),
 ) -> Row {
-    let (runs, min_row_time) = (options.runs.max(1), options.min_row_time);
     let settings = kind.settings(scene);
-    let once = || {
-        let f = render(
+    let render_once = || {
+        render(
             scene,
-            &scene.camera,
-            &scene.lights,
+            &scene.camera(),
+            scene.lights(),
             &settings,
             width,
             height,
-        );
-        let t = f.stats.elapsed;
-        (f, t)
+        )
     };
-    let (frame, _) = once();
-    tick();
-    let mut times: Vec<Duration> = Vec::with_capacity(runs as usize);
-    let mut total = Duration::ZERO;
-    while times.len() < runs as usize
-        || (total < min_row_time && times.len() < MAX_RUNS.max(runs) as usize)
-    {
-        let (f, t) = once();
-        debug_assert_eq!(f.image, frame.image, "frames are deterministic");
-        times.push(t);
-        total += t;
-        if times.len() <= runs as usize {
-            tick();
-        }
-    }
-    times.sort();
-    let ms = |d: Duration| d.as_secs_f64() * 1e3;
-    let median_ms = ms(crate::bench::scene::median(&times));
+    let runs = Runs {
+        min: options.runs.max(1),
+        min_total: options.min_row_time,
+        max: MAX_RUNS,
+    };
+    // The first (warm-up) frame is kept for the error columns; every later one must equal it.
+    let mut kept: Option<crate::render::Frame> = None;
+    let timing = timing::measure(
+        runs,
+        || {
+            let f = render_once();
+            let t = f.stats.elapsed;
+            match &kept {
+                None => kept = Some(f),
+                Some(k) => debug_assert_eq!(f.image, k.image, "frames are deterministic"),
+            }
+            t
+        },
+        tick,
+    );
+    let frame = kept.expect("measure renders at least once");
+    let median_ms = ms(timing.median());
     let rays = frame.stats.rays;
     Row {
         width,
         height,
         kind,
         median_ms,
-        runs: times.len() as u32,
-        min_ms: ms(times[0]),
-        max_ms: ms(times[times.len() - 1]),
+        runs: timing.runs(),
+        min_ms: ms(timing.min()),
+        max_ms: ms(timing.max()),
         rays,
         mrays_per_s: rays.total() as f64 / (median_ms * 1e-3).max(1e-9) / 1e6,
         rmse: metrics::rmse(&frame.image, reference),

@@ -3,6 +3,7 @@
 
 use std::fmt::Write as _;
 
+use super::table::{Align, Table};
 use super::{BenchReport, Row, RowKind};
 
 /// The README's markers: [`rewrite_readme`] replaces what lies between them.
@@ -41,19 +42,17 @@ pub fn markdown(report: &BenchReport, command: &str) -> String {
         "Measured {} on {}, {} threads{load}, with `{command}`.\n",
         env.date, env.machine, env.threads
     );
-    let cols = &COLUMNS;
-    let _ = writeln!(s, "| {} |", cols.join(" | "));
-    let align: Vec<&str> = cols
-        .iter()
-        .map(|c| match *c {
-            "size" | "row" => "---",
-            _ => "---:",
-        })
-        .collect();
-    let _ = writeln!(s, "|{}|", align.join("|"));
+    let mut table = Table::new(COLUMNS.iter().map(|&c| {
+        let align = match c {
+            "size" | "row" => Align::Left,
+            _ => Align::Right,
+        };
+        (c, align)
+    }));
     for r in &report.rows {
-        let _ = writeln!(s, "| {} |", cells(r).join(" | "));
+        table.row(cells(r));
     }
+    s.push_str(&table.to_markdown());
     s.push('\n');
     for info in &report.references {
         let _ = writeln!(s, "- {}", info.describe());

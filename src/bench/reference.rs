@@ -2,12 +2,13 @@
 //! and bounces, rendered once and cached on disk, keyed by everything that decides its pixels.
 
 use std::fs;
-use std::io::{self, IsTerminal};
+use std::io;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use super::progress::Progress;
 
 use crate::image::Image;
 use crate::render::render;
@@ -46,7 +47,7 @@ impl ReferenceSpec {
     /// The spec for `scene` at `width`×`height`, with `spp` rounded up to whole passes.
     pub fn new(scene: &Scene, width: u32, height: u32, spp: u32, bounces: u32) -> ReferenceSpec {
         ReferenceSpec {
-            scene: scene.name.clone(),
+            scene: scene.name().to_string(),
             width,
             height,
             spp: spp.max(1).div_ceil(PASS_SPP) * PASS_SPP,
@@ -159,13 +160,12 @@ pub fn default_cache_dir() -> PathBuf {
 }
 
 /// The reference for `spec`, from `dir` if cached there, else rendered (resuming a partial
-/// render left by an interrupted run) and written there. A progress bar goes to stderr when
-/// `progress` is true and stderr is a terminal.
+/// render left by an interrupted run) and written there, reporting its passes to `progress`.
 pub fn load_or_render(
     scene: &Scene,
     spec: &ReferenceSpec,
     dir: &Path,
-    progress: bool,
+    progress: &mut dyn Progress,
 ) -> io::Result<(Image, ReferenceInfo)> {
     let path = dir.join(spec.file_name());
     let info = |cached, render_time, resumed_spp| ReferenceInfo {
@@ -217,20 +217,19 @@ pub fn load_or_render(
         }
     }
 
-    let bar = progress_bar(
-        u64::from(passes),
+    progress.start(
         &format!("reference {}x{}", spec.width, spec.height),
-        progress,
+        u64::from(passes),
+        u64::from(done),
     );
     let resumed = done;
-    bar.set_position(u64::from(done));
     let start = Instant::now();
     let mut mean = Image::new(spec.width, spec.height);
     for pass in done..passes {
         let frame = render(
             scene,
-            &scene.camera,
-            &scene.lights,
+            &scene.camera(),
+            scene.lights(),
             &spec.settings(pass),
             spec.width,
             spec.height,
@@ -246,30 +245,13 @@ pub fn load_or_render(
             write_atomically(&partial, &pfm_bytes(&mean)?)?;
             fs::write(&partial_count, format!("{}\n", pass + 1))?;
         }
-        bar.inc(1);
+        progress.advance(1);
     }
-    bar.finish_and_clear();
+    progress.finish();
     write_atomically(&path, &pfm_bytes(&mean)?)?;
     let _ = fs::remove_file(&partial);
     let _ = fs::remove_file(&partial_count);
     Ok((mean, info(false, start.elapsed(), resumed * PASS_SPP)))
-}
-
-/// A bar on stderr, hidden unless `show` and stderr is a terminal.
-pub fn progress_bar(len: u64, message: &str, show: bool) -> ProgressBar {
-    let target = if show && io::stderr().is_terminal() {
-        ProgressDrawTarget::stderr()
-    } else {
-        ProgressDrawTarget::hidden()
-    };
-    let bar = ProgressBar::with_draw_target(Some(len), target);
-    if let Ok(style) = ProgressStyle::with_template(
-        "{msg:>22} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.set_message(message.to_string());
-    bar
 }
 
 fn pfm_bytes(img: &Image) -> io::Result<Vec<u8>> {
@@ -327,6 +309,7 @@ pub fn read_pfm(bytes: &[u8]) -> Option<Image> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bench::NoProgress;
 
     #[test]
     fn pfm_round_trips() {
@@ -347,14 +330,14 @@ mod tests {
         let tmp = std::env::temp_dir().join(format!("raytty-ref-test-{}", std::process::id()));
         let (a, b) = (tmp.join("a"), tmp.join("b"));
         let spec = |spp| ReferenceSpec::new(&scene, 12, 10, spp, 4);
-        let (whole, info) = load_or_render(&scene, &spec(48), &a, false).unwrap();
+        let (whole, info) = load_or_render(&scene, &spec(48), &a, &mut NoProgress).unwrap();
         assert!(!info.cached);
-        load_or_render(&scene, &spec(16), &b, false).unwrap();
-        let (resumed, _) = load_or_render(&scene, &spec(48), &b, false).unwrap();
+        load_or_render(&scene, &spec(16), &b, &mut NoProgress).unwrap();
+        let (resumed, _) = load_or_render(&scene, &spec(48), &b, &mut NoProgress).unwrap();
         for (p, q) in whole.pixels.iter().zip(&resumed.pixels) {
             assert!((*p - *q).abs().max_element() <= 1e-5 * p.max_element().max(1.0));
         }
-        let (again, info) = load_or_render(&scene, &spec(48), &b, false).unwrap();
+        let (again, info) = load_or_render(&scene, &spec(48), &b, &mut NoProgress).unwrap();
         assert!(info.cached && info.describe().contains("read from the cache"));
         assert_eq!(again, resumed);
         let _ = fs::remove_dir_all(&tmp);

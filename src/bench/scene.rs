@@ -7,6 +7,8 @@
 use std::fmt::Write as _;
 use std::time::Duration;
 
+use super::table::{Align, Table};
+use super::timing::{self, Runs, ms};
 use crate::accel::AccelStats;
 use crate::render::render;
 use crate::scene::Scene;
@@ -60,7 +62,7 @@ pub struct SceneBench {
 /// one) at each size with the scene's own camera, lights and effects, after one untimed frame.
 pub fn bench_scene(scene: &Scene, sizes: &[(u32, u32)], runs: u32) -> SceneBench {
     let accel = scene.build_accel(scene.accel_stats().kind).stats();
-    let settings = Stage::Indirect.settings(scene.effects);
+    let settings = Stage::Indirect.settings(scene.effects());
     let runs = runs.max(1);
     let sizes = sizes
         .iter()
@@ -68,54 +70,44 @@ pub fn bench_scene(scene: &Scene, sizes: &[(u32, u32)], runs: u32) -> SceneBench
             let frame = || {
                 render(
                     scene,
-                    &scene.camera,
-                    &scene.lights,
+                    &scene.camera(),
+                    scene.lights(),
                     &settings,
                     width,
                     height,
                 )
             };
             let rays = frame().stats.rays.total();
-            let mut times: Vec<Duration> = (0..runs)
-                .map(|_| {
+            let timing = timing::measure(
+                Runs {
+                    min: runs,
+                    min_total: Duration::ZERO,
+                    max: runs,
+                },
+                || {
                     let f = frame();
                     debug_assert_eq!(f.stats.rays.total(), rays);
                     f.stats.elapsed
-                })
-                .collect();
-            times.sort_unstable();
+                },
+                || {},
+            );
             SizeBench {
                 width,
                 height,
-                runs,
-                median: median(&times),
-                min: times[0],
-                max: times[times.len() - 1],
+                runs: timing.runs(),
+                median: timing.median(),
+                min: timing.min(),
+                max: timing.max(),
                 rays,
             }
         })
         .collect();
     SceneBench {
-        scene: scene.name.clone(),
+        scene: scene.name().to_string(),
         accel,
         threads: rayon::current_num_threads(),
         sizes,
     }
-}
-
-/// The median of sorted, non-empty times (the mean of the middle two for an even count).
-/// The median of sorted durations (the mean of the middle two for an even count).
-pub(crate) fn median(sorted: &[Duration]) -> Duration {
-    let n = sorted.len();
-    if n % 2 == 1 {
-        sorted[n / 2]
-    } else {
-        (sorted[n / 2 - 1] + sorted[n / 2]) / 2
-    }
-}
-
-fn ms(d: Duration) -> f64 {
-    d.as_secs_f64() * 1e3
 }
 
 impl SceneBench {
@@ -134,22 +126,27 @@ impl SceneBench {
             ms(a.build),
             self.threads
         );
-        s.push_str("| size | runs | median ms | min ms | max ms | rays/frame | M rays/s |\n");
-        s.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+        let mut table = Table::new([
+            ("size", Align::Left),
+            ("runs", Align::Right),
+            ("median ms", Align::Right),
+            ("min ms", Align::Right),
+            ("max ms", Align::Right),
+            ("rays/frame", Align::Right),
+            ("M rays/s", Align::Right),
+        ]);
         for z in &self.sizes {
-            let _ = writeln!(
-                s,
-                "| {}×{} | {} | {:.2} | {:.2} | {:.2} | {} | {:.2} |",
-                z.width,
-                z.height,
-                z.runs,
-                ms(z.median),
-                ms(z.min),
-                ms(z.max),
-                z.rays,
-                z.mrays_per_s()
-            );
+            table.row([
+                format!("{}×{}", z.width, z.height),
+                z.runs.to_string(),
+                format!("{:.2}", ms(z.median)),
+                format!("{:.2}", ms(z.min)),
+                format!("{:.2}", ms(z.max)),
+                z.rays.to_string(),
+                format!("{:.2}", z.mrays_per_s()),
+            ]);
         }
+        s.push_str(&table.to_markdown());
         s
     }
 }
@@ -176,15 +173,5 @@ mod tests {
             "{md}"
         );
         assert!(md.starts_with("Scene `cornell`: 30 triangles"), "{md}");
-    }
-
-    #[test]
-    fn median_of_odd_and_even_counts() {
-        let d = Duration::from_millis;
-        assert_eq!(median(&[d(1), d(2), d(9)]), d(2));
-        assert_eq!(
-            median(&[d(1), d(3), d(4), d(9)]),
-            Duration::from_micros(3500)
-        );
     }
 }

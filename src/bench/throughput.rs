@@ -6,7 +6,8 @@
 //! faces the light, offset off its surface, to the scene's first light; any-hit, stopping
 //! [`SHADOW_EPSILON`] short), **bounce** (a cosine-weighted direction from each hit, seeded by
 //! pixel; closest hit) and **reflection** (the camera ray mirrored at each hit; closest hit).
-//! A batch is traced once untimed, then `runs` times; the median counts.
+//! A batch is traced once untimed, then `runs` times ([`timing::measure`], timed by the clock
+//! around the tracing alone); the median counts.
 
 use std::fmt::Write as _;
 use std::time::{Duration, Instant};
@@ -14,6 +15,8 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::table::{Align, Table};
+use super::timing::{self, Runs};
 use crate::accel::Isa;
 use crate::geometry::{Ray, hit_point, offset_ray_origin};
 use crate::rng::Rng;
@@ -62,8 +65,8 @@ struct Batch {
 }
 
 fn batches(scene: &Scene, width: u32, height: u32) -> Vec<Batch> {
-    let camera = scene.camera.rays(width, height);
-    let light = scene.lights.first().map(|l| l.position);
+    let camera = scene.camera().rays(width, height);
+    let light = scene.lights().first().map(|l| l.position);
     let mut primary = Vec::new();
     let mut shadow = Vec::new();
     let mut bounce = Vec::new();
@@ -75,7 +78,7 @@ fn batches(scene: &Scene, width: u32, height: u32) -> Vec<Batch> {
             let Some(hit) = scene.intersect(&ray, f32::INFINITY) else {
                 continue;
             };
-            let tri = &scene.triangles[hit.triangle as usize];
+            let tri = &scene.triangles()[hit.triangle as usize];
             let (p, err) = hit_point(&tri.v, hit.b);
             let n = if tri.normal.dot(ray.dir) > 0.0 {
                 -tri.normal
@@ -144,16 +147,27 @@ fn trace(scene: &Scene, b: &Batch, parallel: bool) -> usize {
 }
 
 fn rate(scene: &Scene, b: &Batch, parallel: bool, runs: u32) -> f64 {
-    let hits = trace(scene, b, parallel);
-    let mut times: Vec<Duration> = (0..runs.max(1))
-        .map(|_| {
+    let mut hits = None;
+    let timing = timing::measure(
+        Runs {
+            min: runs.max(1),
+            min_total: Duration::ZERO,
+            max: runs.max(1),
+        },
+        || {
             let start = Instant::now();
-            assert_eq!(trace(scene, b, parallel), hits);
-            start.elapsed()
-        })
-        .collect();
-    times.sort_unstable();
-    let median = super::scene::median(&times).as_secs_f64();
+            let n = trace(scene, b, parallel);
+            let elapsed = start.elapsed();
+            assert_eq!(
+                *hits.get_or_insert(n),
+                n,
+                "a batch traced twice hit differently"
+            );
+            elapsed
+        },
+        || {},
+    );
+    let median = timing.median().as_secs_f64();
     if median > 0.0 {
         b.rays.len() as f64 / median / 1e6
     } else {
@@ -173,8 +187,8 @@ pub fn measure(scene: &Scene, width: u32, height: u32, runs: u32) -> Throughput 
         })
         .collect();
     Throughput {
-        scene: scene.name.clone(),
-        triangles: scene.triangles.len(),
+        scene: scene.name().to_string(),
+        triangles: scene.triangles().len(),
         accel: scene.accel_stats().kind.name(),
         width,
         height,
@@ -196,27 +210,30 @@ pub fn markdown(results: &[Throughput]) -> String {
         first.isa.name(),
         first.threads
     );
-    let _ = writeln!(
-        s,
-        "| scene | triangles | structure | rays from | kind | rays | M rays/s, 1 thread | M rays/s, all |"
-    );
-    let _ = writeln!(s, "|---|---:|---|---|---|---:|---:|---:|");
+    let mut table = Table::new([
+        ("scene", Align::Left),
+        ("triangles", Align::Right),
+        ("structure", Align::Left),
+        ("rays from", Align::Left),
+        ("kind", Align::Left),
+        ("rays", Align::Right),
+        ("M rays/s, 1 thread", Align::Right),
+        ("M rays/s, all", Align::Right),
+    ]);
     for t in results {
         for k in &t.kinds {
-            let _ = writeln!(
-                s,
-                "| {} | {} | {} | {}×{} | {} | {} | {:.2} | {:.2} |",
-                t.scene,
-                t.triangles,
-                t.accel,
-                t.width,
-                t.height,
-                k.kind,
-                k.rays,
-                k.one_thread,
-                k.all_threads
-            );
+            table.row([
+                t.scene.clone(),
+                t.triangles.to_string(),
+                t.accel.to_string(),
+                format!("{}×{}", t.width, t.height),
+                k.kind.to_string(),
+                k.rays.to_string(),
+                format!("{:.2}", k.one_thread),
+                format!("{:.2}", k.all_threads),
+            ]);
         }
     }
+    s.push_str(&table.to_markdown());
     s
 }

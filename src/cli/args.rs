@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
+use raytty::scene::MAX_COORDINATE;
 use raytty::{ColorMode, Stage};
 
 /// Renders the Cornell box (or another scene) by ray tracing, in the terminal.
@@ -80,22 +81,22 @@ pub(super) struct BenchArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub(super) runs: Option<u32>,
     /// GI rows go 1, 4, 16, … samples per pixel up to this (default 64).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536), conflicts_with = "scene")]
     pub(super) max_spp: Option<u32>,
     /// The reference's samples per pixel (default 1024).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576), conflicts_with = "scene")]
     pub(super) ref_spp: Option<u32>,
     /// The reference's maximum bounces (default 16).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024), conflicts_with = "scene")]
     pub(super) ref_bounces: Option<u32>,
     /// Print CSV instead of the Markdown table.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "scene")]
     pub(super) csv: bool,
     /// Write the error-against-time plot (log axes) to PATH as SVG.
-    #[arg(long, value_name = "PATH")]
+    #[arg(long, value_name = "PATH", conflicts_with = "scene")]
     pub(super) svg: Option<PathBuf>,
     /// Rewrite the table between <!-- bench:start --> and <!-- bench:end --> in PATH.
-    #[arg(long, value_name = "PATH")]
+    #[arg(long, value_name = "PATH", conflicts_with = "scene")]
     pub(super) readme: Option<PathBuf>,
     /// Tiny sizes, 2 runs, a small reference: seconds, for tests.
     #[arg(long)]
@@ -163,10 +164,6 @@ pub(super) enum StatsFormat {
     Json,
 }
 
-/// Most pixels `--pixels` may ask for: about 48 bytes each (float image, cached hits, 8-bit
-/// copy, encoder buffers), so 64 Mpixel stays near 3 GiB.
-pub(super) const MAX_PIXELS: u64 = 64 * 1024 * 1024;
-
 pub(super) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let bad = || {
         format!(
@@ -202,9 +199,9 @@ pub(super) fn parse_floats<const N: usize>(s: &str, what: &str) -> Result<[f32; 
             .trim()
             .parse()
             .map_err(|_| format!("'{p}' in '{s}' is not a number"))?;
-        if !o.is_finite() || o.abs() > 1e6 {
+        if !o.is_finite() || o.abs() > MAX_COORDINATE {
             return Err(format!(
-                "'{p}' in '{s}' is out of range: expected a finite number within ±1e6"
+                "'{p}' in '{s}' is out of range: expected a finite number within ±{MAX_COORDINATE:e}"
             ));
         }
     }

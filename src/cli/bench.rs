@@ -2,41 +2,24 @@
 
 use std::io::{self, Write};
 
-use anyhow::{Result, bail};
-
-use super::UsageError;
 use super::args::*;
+use super::progress::Bar;
+use super::{Failure, Result, usage};
 
 /// `raytty bench`: with no `--scene`, the accuracy price list of the Cornell box; with
 /// `--scene`, what that scene costs (load and acceleration build, frame times, M rays/s).
 pub(super) fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
     if let Some(name) = scene {
-        // These shape the accuracy bench only: refuse them rather than ignore them.
-        let unused: Vec<&str> = [
-            (a.csv, "--csv"),
-            (a.svg.is_some(), "--svg"),
-            (a.readme.is_some(), "--readme"),
-            (a.max_spp.is_some(), "--max-spp"),
-            (a.ref_spp.is_some(), "--ref-spp"),
-            (a.ref_bounces.is_some(), "--ref-bounces"),
-        ]
-        .into_iter()
-        .filter_map(|(given, flag)| given.then_some(flag))
-        .collect();
-        if !unused.is_empty() {
-            bail!(UsageError(format!(
-                "{} belong to the accuracy bench (no --scene); with --scene, bench times frames: --sizes, --runs, --quick",
-                unused.join(", ")
-            )));
-        }
-        let start = std::time::Instant::now();
-        let scene = crate::cli::scene_arg::load_scene(Some(name))?;
-        let load = start.elapsed();
+        // The flags that shape the accuracy bench only conflict with --scene (args.rs).
         let sizes = match (a.sizes.is_empty(), a.quick) {
             (false, _) => a.sizes,
             (true, true) => raytty::bench::BenchOptions::quick().sizes,
             (true, false) => vec![(200, 100), (500, 500)],
         };
+        raytty::bench::check_sizes(&sizes).map_err(bench_failure)?;
+        let start = std::time::Instant::now();
+        let scene = crate::cli::scene_arg::load_scene(Some(name))?;
+        let load = start.elapsed();
         let runs = a.runs.unwrap_or(if a.quick { 2 } else { 5 });
         let report = raytty::bench::scene::bench_scene(&scene, &sizes, runs);
         let mut out = io::stdout().lock();
@@ -54,11 +37,11 @@ pub(super) fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
         && !dir.as_os_str().is_empty()
         && !dir.is_dir()
     {
-        bail!(UsageError(format!(
+        usage!(
             "--svg {}: the folder {} does not exist",
             a.svg.as_deref().unwrap_or(dir).display(),
             dir.display()
-        )));
+        );
     }
     let request = raytty::bench::BenchRequest {
         quick: a.quick,
@@ -80,10 +63,17 @@ pub(super) fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
         &request,
         &mut io::stdout().lock(),
         &mut io::stderr().lock(),
+        &mut Bar::default(),
     )
-    .map_err(|e| match e {
-        raytty::bench::BenchError::Usage(m) => UsageError(m).into(),
+    .map_err(bench_failure)
+}
+
+fn bench_failure(e: raytty::bench::BenchError) -> Failure {
+    match e {
+        raytty::bench::BenchError::Usage(m) => Failure::Usage(m),
         // The I/O error as the cause, said once (BenchError's own text repeats it).
-        raytty::bench::BenchError::Io { what, error } => anyhow::Error::new(error).context(what),
-    })
+        raytty::bench::BenchError::Io { what, error } => {
+            Failure::Run(anyhow::Error::new(error).context(what))
+        }
+    }
 }

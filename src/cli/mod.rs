@@ -1,16 +1,19 @@
 //! Command-line parsing and the non-interactive commands. The exit code is chosen here, once:
 //! 0 for success (a closed output pipe included), 1 for a failure while running, 2 for bad
-//! input (clap's own usage errors are 2 as well).
+//! input (clap's own usage errors are 2 as well), and for the app 128 + N after signal N
+//! ([`signal_status`]; a dropped terminal counts as SIGHUP).
 
 mod args;
 mod bench;
+mod progress;
 mod render;
 pub mod scene_arg;
 
-use std::io::{self, IsTerminal, Write};
+#[cfg(feature = "tui")]
+use std::io::IsTerminal;
+use std::io::{self, Write};
 use std::process::ExitCode;
 
-use anyhow::Result;
 use clap::{CommandFactory, FromArgMatches};
 use raytty::{ColorMode, Stage};
 
@@ -26,7 +29,9 @@ pub fn main() -> ExitCode {
     {
         cmd = cmd.after_long_help(crate::tui::keys::help_text());
     }
-    let cli = Cli::from_arg_matches(&cmd.get_matches()).unwrap_or_else(|e| e.exit());
+    let matches = cmd.get_matches_mut();
+    global_conflicts(&mut cmd, &matches).unwrap_or_else(|e| e.exit());
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     let dumb = is_dumb(std::env::var("TERM").ok().as_deref());
     let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
     let color = resolve_color(
@@ -47,29 +52,107 @@ pub fn main() -> ExitCode {
     };
     match result {
         Ok(code) => code,
-        Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
-        Err(e) => {
+        Err(Failure::Usage(message)) => {
+            eprintln!("raytty: {}", without_os_error(&message));
+            ExitCode::from(2)
+        }
+        Err(Failure::Run(e)) if is_broken_pipe(&e) => ExitCode::SUCCESS,
+        Err(Failure::Run(e)) => {
             eprintln!("raytty: {}", without_os_error(&format!("{e:#}")));
-            ExitCode::from(if e.downcast_ref::<UsageError>().is_some() {
-                2
-            } else {
-                1
-            })
+            ExitCode::from(1)
         }
     }
 }
 
-/// An error in what the user asked for (exit status 2).
-#[derive(Debug)]
-pub struct UsageError(pub String);
+/// The exit status of a run ended by signal `sig`: 128 + N, as shells report it. The app's
+/// forced exit after a signal (when its loop cannot return in time) uses this too.
+#[cfg(feature = "tui")]
+pub fn signal_status(sig: i32) -> u8 {
+    (128 + sig).clamp(0, 255) as u8
+}
 
-impl std::fmt::Display for UsageError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
+/// The exit status of the app: 0 on quit, [`signal_status`] of the signal, and for a dropped
+/// terminal that of SIGHUP (129), as if the hangup had been signalled.
+#[cfg(feature = "tui")]
+fn app_status(outcome: crate::tui::Outcome) -> ExitCode {
+    use crate::tui::Outcome;
+    match outcome {
+        Outcome::Quit => ExitCode::SUCCESS,
+        Outcome::Signal(sig) => ExitCode::from(signal_status(sig)),
+        Outcome::Hangup => ExitCode::from(signal_status(libc::SIGHUP)),
     }
 }
 
-impl std::error::Error for UsageError {}
+/// `--scene` is a global flag, and clap checks a subcommand's `conflicts_with = "scene"` only
+/// when `--scene` is given after the subcommand. This applies the same declarations (args.rs is
+/// the one place that states them) when it comes before: `raytty --scene sphere bench --csv`.
+fn global_conflicts(
+    cmd: &mut clap::Command,
+    matches: &clap::ArgMatches,
+) -> std::result::Result<(), clap::Error> {
+    use clap::parser::ValueSource::CommandLine;
+    let Some((name, sub)) = matches.subcommand() else {
+        return Ok(());
+    };
+    if matches.value_source("scene") != Some(CommandLine) {
+        return Ok(());
+    }
+    let Some(sub_cmd) = cmd.find_subcommand_mut(name) else {
+        return Ok(());
+    };
+    let given = sub_cmd.get_arguments().find(|arg| {
+        sub.value_source(arg.get_id().as_str()) == Some(CommandLine)
+            && sub_cmd
+                .get_arg_conflicts_with(arg)
+                .iter()
+                .any(|c| c.get_id() == "scene")
+    });
+    match given {
+        Some(arg) => {
+            let flag = format!("--{}", arg.get_long().unwrap_or(arg.get_id().as_str()));
+            Err(clap::Error::raw(
+                clap::error::ErrorKind::ArgumentConflict,
+                format!("the argument '{flag}' cannot be used with '--scene <PATH|NAME>'"),
+            )
+            .format(sub_cmd))
+        }
+        None => Ok(()),
+    }
+}
+
+/// Why a command failed; its variant, and nothing else, picks the exit status in [`main`].
+#[derive(Debug)]
+pub enum Failure {
+    /// What the user asked for is wrong or impossible, and the message says what would work:
+    /// exit status 2 (clap's own usage errors are 2 as well).
+    Usage(String),
+    /// Running failed (I/O, a file that cannot be written): exit status 1, or 0 when the
+    /// output pipe was closed by its reader.
+    Run(anyhow::Error),
+}
+
+impl From<anyhow::Error> for Failure {
+    fn from(e: anyhow::Error) -> Failure {
+        Failure::Run(e)
+    }
+}
+
+impl From<io::Error> for Failure {
+    fn from(e: io::Error) -> Failure {
+        Failure::Run(e.into())
+    }
+}
+
+/// What the commands return.
+pub type Result<T> = std::result::Result<T, Failure>;
+
+/// Returns a [`Failure::Usage`] with a `format!` message.
+macro_rules! usage {
+    ($($arg:tt)*) => {
+        return Err($crate::cli::Failure::Usage(format!($($arg)*)))
+    };
+}
+pub(crate) use usage;
 
 fn is_broken_pipe(e: &anyhow::Error) -> bool {
     e.chain().any(|c| {
@@ -103,7 +186,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
             if note {
                 eprint!("\r\x1b[2K");
             }
-            return crate::tui::run(loaded?, color);
+            return Ok(crate::tui::run(loaded?, color).map(app_status)?);
         }
         eprintln!("raytty: TERM=dumb cannot run the app (it moves the cursor): one frame follows");
     }

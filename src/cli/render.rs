@@ -3,24 +3,26 @@
 use std::fs::File;
 use std::io::{self, BufWriter, IsTerminal, Write};
 
-use anyhow::{Context, Result, bail};
+use anyhow::Context;
 use clap::ValueEnum;
 use glam::Vec3;
 use raytty::{CellGrid, ColorMode, PointLight, Scene, encode_text, render};
 
-use super::UsageError;
+use raytty::image::MAX_PIXELS;
+
 use super::args::*;
+use super::{Result, usage};
 
 /// `raytty render`; `no_color` (NO_COLOR is set) makes ascii the default text format.
 pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool) -> Result<()> {
     if let Some(ext) = args.output.as_deref().and_then(unwritable_image_extension) {
-        bail!(UsageError(format!(
+        usage!(
             "-o {}: raytty cannot write .{ext} images: use a .png or .pfm file name (or --format ascii|ansi|ansi256 for text)",
             args.output
                 .as_deref()
                 .unwrap_or_else(|| "".as_ref())
                 .display()
-        )));
+        );
     }
     let format = args
         .format
@@ -30,10 +32,10 @@ pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool)
         });
     let image_format = matches!(format, Format::Png | Format::Pfm);
     if image_format && args.output.is_none() && io::stdout().is_terminal() {
-        bail!(UsageError(format!(
+        usage!(
             "--format {} writes binary data: give -o FILE or redirect stdout",
             format_name(format)
-        )));
+        );
     }
     let (w, h) = match (args.pixels, args.size, image_format) {
         (Some(p), _, _) => p,
@@ -47,24 +49,24 @@ pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool)
             Some(_) => format!("--pixels {w}x{h} is"),
             None => format!("--size {}x{} is {w}x{h} =", w, h / 2),
         };
-        bail!(UsageError(format!(
+        usage!(
             "{asked} {pixels} pixels, about {} MiB of memory; the limit is {MAX_PIXELS} pixels (e.g. --pixels 8192x8192 or --size 8192x4096)",
             pixels * 48 / (1024 * 1024)
-        )));
+        );
     }
     let scene = crate::cli::scene_arg::load_scene(scene)?;
-    let mut camera = scene.camera;
+    let mut camera = scene.camera();
     if let Some([x, y, z, yaw]) = args.camera {
         camera.position = Vec3::new(x, y, z);
         camera.yaw = yaw.to_radians();
     }
-    if args.light.is_some() && scene.lights.is_empty() {
-        bail!(UsageError(
-            "--light moves the scene's first light, and this scene has none: add a [[light]] to the scene file".into()
-        ));
+    if args.light.is_some() && scene.lights().is_empty() {
+        usage!(
+            "--light moves the scene's first light, and this scene has none: add a [[light]] to the scene file"
+        );
     }
     let lights = lights_with(&scene, args.light);
-    let mut settings = args.stage.settings(scene.effects);
+    let mut settings = args.stage.settings(scene.effects());
     if let Some(n) = args.samples {
         settings.effects.samples = n;
     }
@@ -159,7 +161,7 @@ pub(super) fn format_name(format: Format) -> String {
 
 /// The scene's lights, with the first one moved to `light` if given.
 pub(super) fn lights_with(scene: &Scene, light: Option<Vec3>) -> Vec<PointLight> {
-    let mut lights = scene.lights.clone();
+    let mut lights = scene.lights().to_vec();
     if let (Some(p), Some(first)) = (light, lights.first_mut()) {
         first.position = p;
     }

@@ -1,14 +1,13 @@
 //! `--scene PATH|NAME`: a scene file if the path exists or ends in `.toml`, else a built-in
-//! scene's name. Every failure is a [`UsageError`] (exit status 2) that says what would work.
+//! scene's name. Every failure is a [`Failure::Usage`] (exit status 2) that says what would work.
 
 use std::path::Path;
 
-use anyhow::{Result, bail};
 use raytty::scene::builtin::{self, BUILTINS};
 use raytty::scene::file;
 use raytty::{Scene, printable};
 
-use crate::cli::UsageError;
+use crate::cli::{Failure, Result, usage};
 
 /// The scene `arg` names; the Cornell box when there is none.
 pub fn load_scene(arg: Option<&str>) -> Result<Scene> {
@@ -18,21 +17,21 @@ pub fn load_scene(arg: Option<&str>) -> Result<Scene> {
     let path = Path::new(arg);
     let builtins = || builtin::names().join(", ");
     if path.is_dir() {
-        bail!(UsageError(format!(
+        usage!(
             "--scene {}: is a folder: give the path of a .toml scene file (or a built-in scene: {})",
             printable(arg),
             builtins()
-        )));
+        );
     }
     if !path.exists() && arg.ends_with(".toml") {
-        bail!(UsageError(format!(
+        usage!(
             "--scene {}: no such file: give the path of an existing .toml scene file (or a built-in scene: {})",
             printable(arg),
             builtins()
-        )));
+        );
     }
     if arg.to_ascii_lowercase().ends_with(".obj") {
-        bail!(UsageError(format!(
+        usage!(
             "--scene {}: an OBJ mesh is not a scene: write a .toml scene with an [[object]] of kind = \"obj\" and path = \"{}\" (scenes/example.toml shows one)",
             printable(arg),
             printable(
@@ -40,19 +39,19 @@ pub fn load_scene(arg: Option<&str>) -> Result<Scene> {
                     .file_name()
                     .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
             )
-        )));
+        );
     }
     if path.exists() {
-        return file::load(path).map_err(|e| UsageError(e.to_string()).into());
+        return file::load(path).map_err(|e| Failure::Usage(e.to_string()));
     }
     match builtin::find(arg) {
-        Some(b) => b.load().map_err(|e| UsageError(e.to_string()).into()),
-        None => bail!(UsageError(format!(
+        Some(b) => b.load().map_err(|e| Failure::Usage(e.to_string())),
+        None => usage!(
             "--scene {}: no such file and no built-in scene of that name{} (built-in scenes: {}; or give the path of a .toml scene file)",
             printable(arg),
             file::did_you_mean(arg, &builtin::names()),
             builtins()
-        ))),
+        ),
     }
 }
 

@@ -18,6 +18,11 @@ use crate::accel::{Accel, AccelKind, AccelStats, Hit, Isa};
 use crate::camera::Camera;
 use crate::geometry::{Aabb, DegenerateTriangle, Ray, Triangle};
 
+/// Largest absolute coordinate accepted anywhere a user gives one (scene files, OBJ vertices,
+/// `--camera` and `--light`; box corners and transformed vertices too): far beyond any sensible
+/// scene, far below where `f32` loses whole units. Exact in `f32` and `f64`.
+pub const MAX_COORDINATE: f32 = 1e6;
+
 /// A surface's material.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -90,20 +95,13 @@ impl Default for Effects {
 /// A renderable scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
-    /// A short name for display (e.g. "cornell").
-    pub name: String,
-    /// All triangles; [`Hit::triangle`] indexes this.
-    pub triangles: Vec<Triangle>,
-    /// Materials; [`Triangle::material`] indexes this.
-    pub materials: Vec<Material>,
-    /// The lights the scene starts with.
-    pub lights: Vec<PointLight>,
-    /// The camera the scene starts with.
-    pub camera: Camera,
-    /// The effects the scene calls for.
-    pub effects: Effects,
-    /// Length of the bounding box's diagonal: the scene's scale.
-    pub extent: f32,
+    name: String,
+    triangles: Vec<Triangle>,
+    materials: Vec<Material>,
+    lights: Vec<PointLight>,
+    camera: Camera,
+    effects: Effects,
+    extent: f32,
     accel: Accel,
     /// The objects as added (ranges of `triangles`), for rebuilding the flat list.
     objects: Vec<Range<usize>>,
@@ -270,6 +268,54 @@ impl SceneBuilder {
 }
 
 impl Scene {
+    /// A short name for display (e.g. "cornell").
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The same scene under another display name (names are shown through
+    /// [`crate::printable`], so any string is safe).
+    pub fn with_name(mut self, name: impl Into<String>) -> Scene {
+        self.name = name.into();
+        self
+    }
+
+    /// All triangles, each finite with a unit normal; [`Hit::triangle`] indexes this.
+    pub fn triangles(&self) -> &[Triangle] {
+        &self.triangles
+    }
+
+    /// Materials; [`Triangle::material`] indexes this.
+    pub fn materials(&self) -> &[Material] {
+        &self.materials
+    }
+
+    /// The lights the scene starts with (finite positions, non-negative power).
+    pub fn lights(&self) -> &[PointLight] {
+        &self.lights
+    }
+
+    /// The camera the scene starts with.
+    pub fn camera(&self) -> Camera {
+        self.camera
+    }
+
+    /// The effects the scene calls for.
+    pub fn effects(&self) -> Effects {
+        self.effects
+    }
+
+    /// The same scene calling for other effects (the geometry, and so its validity, unchanged).
+    pub fn with_effects(mut self, effects: Effects) -> Scene {
+        self.effects = effects;
+        self
+    }
+
+    /// Length of the bounding box's diagonal: the scene's scale.
+    pub fn extent(&self) -> f32 {
+        self.extent
+    }
+
     /// The closest hit along `ray` with `t < t_max`.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {

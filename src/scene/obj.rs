@@ -4,13 +4,21 @@
 //! (normals are optional in OBJ and the tracer uses geometric normals). Negative indices count
 //! back from the last vertex read. Polygons are fanned into triangles from their first vertex.
 //! Every other statement (`vt`, `vn`, `o`, `g`, `s`, `usemtl`, `mtllib`, `l`, ...) is ignored.
-//! Every error names its line and column.
+//! Every error names its line and column (in characters, as scene-file errors do). A UTF-8 byte
+//! order mark at the start of the file (Windows editors write one) is skipped.
 //!
 //! Why not the `tobj` crate: its errors say what went wrong but not where, and every mistake in
 //! a user's file must name its line and column; it also loads materials and texture
 //! coordinates that the tracer has no use for. What raytty needs of OBJ fits in this file.
 
+use std::borrow::Cow;
+
 use glam::Vec3;
+
+use crate::scene::MAX_COORDINATE;
+
+/// The UTF-8 byte order mark, which some editors write at the start of a text file.
+const BOM: &[u8] = b"\xEF\xBB\xBF";
 
 /// A mesh's triangles, each with the line and column of the face it came from.
 #[derive(Clone, Debug, Default)]
@@ -26,14 +34,11 @@ pub struct ObjMesh {
 pub struct ObjError {
     /// 1-based line.
     pub line: usize,
-    /// 1-based column in bytes.
+    /// 1-based column in characters (invalid UTF-8 counts as [`line_text`] shows it).
     pub column: usize,
     /// What was wrong and what would be right.
     pub message: String,
 }
-
-/// Largest absolute vertex coordinate accepted (the same bound as scene-file coordinates).
-pub const MAX_COORDINATE: f32 = 1e6;
 
 /// Reads `bytes` as OBJ, giving up with an error past `max_triangles` triangles or
 /// `max_vertices` vertices.
@@ -45,6 +50,7 @@ pub fn parse_obj(
     let mut vertices: Vec<Vec3> = Vec::new();
     let mut mesh = ObjMesh::default();
     let mut face: Vec<Vec3> = Vec::new();
+    let bytes = bytes.strip_prefix(BOM).unwrap_or(bytes);
     for (n, raw) in bytes.split(|&b| b == b'\n').enumerate() {
         let line = n + 1;
         let content = match raw.iter().position(|&b| b == b'#') {
@@ -55,9 +61,10 @@ pub fn parse_obj(
         let Some((col, keyword)) = tokens.next() else {
             continue;
         };
-        let err = |column: usize, message: String| ObjError {
+        // Token columns are bytes; an error converts its own to characters.
+        let err = |byte_column: usize, message: String| ObjError {
             line,
-            column,
+            column: char_column(raw, byte_column),
             message,
         };
         match keyword {
@@ -147,6 +154,8 @@ pub fn parse_obj(
                         format!("the mesh has more than {max_triangles} triangles, the limit"),
                     ));
                 }
+                // Only ASCII whitespace comes before the keyword: its byte column is its
+                // character column.
                 let origin = (line.min(u32::MAX as usize) as u32, col as u32);
                 for i in 1..face.len() - 1 {
                     mesh.triangles.push([face[0], face[i], face[i + 1]]);
@@ -157,6 +166,24 @@ pub fn parse_obj(
         }
     }
     Ok(mesh)
+}
+
+/// Line `line` (1-based) of an OBJ file's `bytes`, as text (invalid UTF-8 replaced by U+FFFD):
+/// the line an [`ObjError`] points into. Only that line is converted, however large the file.
+pub fn line_text(bytes: &[u8], line: usize) -> Cow<'_, str> {
+    let bytes = bytes.strip_prefix(BOM).unwrap_or(bytes);
+    let raw = bytes
+        .split(|&b| b == b'\n')
+        .nth(line.saturating_sub(1))
+        .unwrap_or_default();
+    String::from_utf8_lossy(raw)
+}
+
+/// The 1-based character column of 1-based byte column `byte_column` in `line`, counting as
+/// [`line_text`] shows the line.
+fn char_column(line: &[u8], byte_column: usize) -> usize {
+    let before = &line[..byte_column.saturating_sub(1).min(line.len())];
+    String::from_utf8_lossy(before).chars().count() + 1
 }
 
 /// The whitespace-separated tokens of a line with their 1-based byte columns.
@@ -214,6 +241,33 @@ mod tests {
         assert!(e.message.contains("3 coordinates"), "{}", e.message);
         let e = parse("v 0 0 0\nv 1 0 0\nf 1 2\n").unwrap_err();
         assert!(e.message.contains("at least 3"), "{}", e.message);
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let m = parse("\u{FEFF}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        assert_eq!(m.triangles, vec![[Vec3::ZERO, Vec3::X, Vec3::Y]]);
+        let e = parse("\u{FEFF}v 0 x 0\n").unwrap_err();
+        assert_eq!((e.line, e.column), (1, 5));
+        assert_eq!(line_text("\u{FEFF}v 0 x 0\n".as_bytes(), 1), "v 0 x 0");
+    }
+
+    #[test]
+    fn columns_count_characters() {
+        // "é" is two bytes and "→" three: the bad index is the 11th character, the 14th byte.
+        let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        let e = parse(&format!("{tri}f 1/é 2/→ 9\n")).unwrap_err();
+        assert_eq!((e.line, e.column), (4, 11), "{}", e.message);
+        // Invalid UTF-8 counts as the replacement character it is shown as: a cut "→" is one.
+        let bad = format!("{tri}f 1/\u{2192} 9\n").replace('\u{2192}', "@");
+        let mut bytes = bad.into_bytes();
+        let at = bytes.iter().position(|&b| b == b'@').unwrap();
+        bytes.splice(at..=at, [0xE2, 0x86]);
+        let e = parse_obj(&bytes, 10, 10).unwrap_err();
+        assert_eq!((e.line, e.column), (4, 7));
+        let shown = line_text(&bytes, 4);
+        assert_eq!(shown, "f 1/\u{FFFD} 9");
+        assert_eq!(shown.chars().nth(e.column - 1), Some('9'));
     }
 
     #[test]

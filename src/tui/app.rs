@@ -66,8 +66,8 @@ impl App {
     /// The app at the scene's starting view, in the default stage.
     pub fn new(scene: Scene, color: ColorMode, size: (u16, u16)) -> App {
         App {
-            camera: scene.camera,
-            lights: scene.lights.clone(),
+            camera: scene.camera(),
+            lights: scene.lights().to_vec(),
             scene,
             stage: Stage::Indirect,
             color,
@@ -117,8 +117,8 @@ pub fn update(app: &mut App, msg: Message) {
             changed
         }
         Message::Reset => {
-            app.camera = app.scene.camera;
-            app.lights = app.scene.lights.clone();
+            app.camera = app.scene.camera();
+            app.lights = app.scene.lights().to_vec();
             true
         }
         Message::CycleColor => {
@@ -185,7 +185,7 @@ mod tests {
         assert!((a.light().unwrap() - start - Vec3::new(0.1, 0.0, 0.0)).length() < TOLERANCE);
         update(&mut a, Message::Reset);
         assert_eq!(a.light(), Some(start));
-        assert_eq!(a.camera, a.scene.camera);
+        assert_eq!(a.camera, a.scene.camera());
     }
 
     #[test]

@@ -16,7 +16,9 @@ pub struct KeyParser {
 
 impl KeyParser {
     /// The key events in `bytes` (after what an earlier call left incomplete). A lone ESC at
-    /// the end of a read is the Esc key, as terminals send escape sequences in one write.
+    /// the end of `bytes` is kept: it may be the start of a sequence split across reads (a slow
+    /// or choppy link splits them). The reader calls [`KeyParser::timeout`] if nothing follows
+    /// within [`ESC_DELAY`].
     pub fn feed(&mut self, bytes: &[u8]) -> Vec<KeyEvent> {
         let mut buf = std::mem::take(&mut self.pending);
         buf.extend_from_slice(bytes);
@@ -38,7 +40,31 @@ impl KeyParser {
         }
         keys
     }
+
+    /// Whether a lone ESC waits for what follows it: the reader then waits at most
+    /// [`ESC_DELAY`] for more bytes before calling [`KeyParser::timeout`].
+    pub fn waiting_on_escape(&self) -> bool {
+        self.pending == [0x1b]
+    }
+
+    /// Nothing followed a lone ESC within [`ESC_DELAY`]: it was the Esc key. A longer
+    /// incomplete sequence (`ESC [ 1 ;`) is kept: a user cannot type that, so the rest is on its
+    /// way.
+    pub fn timeout(&mut self) -> Vec<KeyEvent> {
+        if self.waiting_on_escape() {
+            self.pending.clear();
+            vec![KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE)]
+        } else {
+            Vec::new()
+        }
+    }
 }
+
+/// How long a lone ESC waits for the rest of an escape sequence before it counts as the Esc
+/// key (ncurses' ESCDELAY, tmux's escape-time). Over a slow or choppy link the bytes of one
+/// arrow key can arrive milliseconds apart; a person pressing Esc waits far longer than this
+/// before expecting a reaction.
+pub const ESC_DELAY: std::time::Duration = std::time::Duration::from_millis(50);
 
 enum Parsed {
     /// Bytes used and the key they make, if any.
@@ -55,7 +81,8 @@ fn parse_one(b: &[u8]) -> Parsed {
     let none = KeyModifiers::NONE;
     match b[0] {
         0x1b => match b.get(1) {
-            None | Some(0x1b) => Parsed::Key(1, key(KeyCode::Esc, none)),
+            None => Parsed::Incomplete,
+            Some(0x1b) => Parsed::Key(1, key(KeyCode::Esc, none)),
             Some(b'[') => parse_csi(b),
             Some(b'O') => match b.get(2) {
                 None => Parsed::Incomplete,
@@ -178,11 +205,33 @@ mod tests {
     }
 
     #[test]
-    fn lone_escape_is_esc_and_split_sequences_wait() {
+    fn lone_escape_is_esc_after_the_delay_and_split_sequences_wait() {
         let mut p = KeyParser::default();
+        assert_eq!(codes(&mut p, b"\x1b"), vec![]);
+        assert!(p.waiting_on_escape());
         assert_eq!(
-            codes(&mut p, b"\x1b"),
+            p.timeout()
+                .into_iter()
+                .map(|k| (k.code, k.modifiers))
+                .collect::<Vec<_>>(),
             vec![(KeyCode::Esc, KeyModifiers::NONE)]
+        );
+        assert!(!p.waiting_on_escape() && p.timeout().is_empty());
+        // An arrow split after its ESC, and after its `[`, as a slow link delivers it.
+        assert_eq!(codes(&mut p, b"\x1b"), vec![]);
+        assert_eq!(codes(&mut p, b"["), vec![]);
+        assert!(!p.waiting_on_escape(), "ESC [ is a sequence under way");
+        assert!(p.timeout().is_empty());
+        assert_eq!(codes(&mut p, b"A"), vec![(KeyCode::Up, KeyModifiers::NONE)]);
+        // Two ESCs in one read: the first is a key, the second waits.
+        assert_eq!(
+            codes(&mut p, b"\x1b\x1b"),
+            vec![(KeyCode::Esc, KeyModifiers::NONE)]
+        );
+        assert!(p.waiting_on_escape());
+        assert_eq!(
+            codes(&mut p, b"OD"),
+            vec![(KeyCode::Left, KeyModifiers::NONE)]
         );
         assert_eq!(
             codes(&mut p, b"w\x1b[1;"),

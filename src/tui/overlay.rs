@@ -2,8 +2,9 @@
 //! cells in the frame's colour mode. Text from outside (a scene name) loses its control
 //! characters first, so nothing shown can send escapes to the terminal.
 
-use raytty::frame::{Cell, Colour};
+use raytty::frame::{Cell, Colour, WIDE_TAIL};
 use raytty::{CellGrid, ColorMode, printable};
+use unicode_width::UnicodeWidthChar;
 
 use super::keys::KEYS;
 
@@ -19,18 +20,50 @@ fn text_colours(mode: ColorMode) -> (Option<Colour>, Option<Colour>) {
     }
 }
 
-/// Writes `text` into `grid` at (`col`, `row`), clipped to the grid, in text colours.
+/// How many terminal columns `text` takes once shown (after [`printable`]): two for a wide
+/// character (CJK, most emoji), none for a combining mark.
+pub fn text_width(text: &str) -> usize {
+    printable(text)
+        .chars()
+        .map(|c| c.width().unwrap_or(0))
+        .sum()
+}
+
+/// Writes `text` into `grid` at (`col`, `row`), clipped to the grid, in text colours. A wide
+/// character takes two cells (the second is [`WIDE_TAIL`]); one that would straddle the right
+/// edge is left out; zero-width characters are dropped.
 pub fn put_text(grid: &mut CellGrid, col: usize, row: usize, text: &str, mode: ColorMode) {
     if row >= grid.rows {
         return;
     }
     let (fg, bg) = text_colours(mode);
-    for (i, ch) in printable(text).chars().enumerate() {
-        let c = col + i;
-        if c >= grid.cols {
+    let start = row * grid.cols;
+    let line = &mut grid.cells[start..start + grid.cols];
+    let mut c = col;
+    for ch in printable(text).chars() {
+        let w = ch.width().unwrap_or(0);
+        if w == 0 {
+            continue;
+        }
+        if c + w > line.len() {
             break;
         }
-        grid.cells[row * grid.cols + c] = Cell { ch, fg, bg };
+        // Half of a wide character left behind would not be drawn: blank it.
+        if line[c].ch == WIDE_TAIL && c > 0 {
+            line[c - 1] = Cell { ch: ' ', fg, bg };
+        }
+        line[c] = Cell { ch, fg, bg };
+        if w == 2 {
+            line[c + 1] = Cell {
+                ch: WIDE_TAIL,
+                fg,
+                bg,
+            };
+        }
+        c += w;
+        if line.get(c).is_some_and(|t| t.ch == WIDE_TAIL) {
+            line[c] = Cell { ch: ' ', fg, bg };
+        }
     }
 }
 
@@ -46,13 +79,8 @@ pub fn blank(cols: usize, rows: usize, mode: ColorMode) -> CellGrid {
 
 /// Fills row `row` with `text`, padded with blanks to the grid's width.
 pub fn put_line(grid: &mut CellGrid, row: usize, text: &str, mode: ColorMode) {
-    let width = grid.cols;
-    let padded: String = printable(text)
-        .chars()
-        .chain(std::iter::repeat(' '))
-        .take(width)
-        .collect();
-    put_text(grid, 0, row, &padded, mode);
+    put_text(grid, 0, row, &" ".repeat(grid.cols), mode);
+    put_text(grid, 0, row, text, mode);
 }
 
 /// The lines of the help box.
@@ -72,7 +100,7 @@ pub fn help_lines() -> Vec<String> {
 /// Draws the help box centred over `grid`, clipped if the grid is small.
 pub fn draw_help(grid: &mut CellGrid, mode: ColorMode) {
     let lines = help_lines();
-    let inner = lines.iter().map(|l| l.chars().count()).max().unwrap_or(0);
+    let inner = lines.iter().map(|l| text_width(l)).max().unwrap_or(0);
     let (w, h) = (inner + 4, lines.len() + 2);
     let left = grid.cols.saturating_sub(w) / 2;
     let top = grid.rows.saturating_sub(h) / 2;
@@ -96,6 +124,41 @@ mod tests {
         put_line(&mut g, 0, "a\x1bb", ColorMode::TrueColor);
         let text: String = g.cells.iter().map(|c| c.ch).collect();
         assert_eq!(text, "ab          ");
+    }
+
+    fn shown(g: &CellGrid) -> String {
+        g.cells
+            .iter()
+            .map(|c| c.ch)
+            .filter(|&c| c != WIDE_TAIL)
+            .collect()
+    }
+
+    #[test]
+    fn wide_characters_take_two_cells_and_never_straddle_the_edge() {
+        let mut g = blank(6, 1, ColorMode::TrueColor);
+        put_line(&mut g, 0, "a漢字😀b", ColorMode::TrueColor);
+        let chars: Vec<char> = g.cells.iter().map(|c| c.ch).collect();
+        assert_eq!(chars, ['a', '漢', WIDE_TAIL, '字', WIDE_TAIL, ' ']);
+        assert_eq!(text_width("a漢字😀b"), 8);
+        // Overwriting half of a wide character blanks the other half.
+        put_text(&mut g, 2, 0, "x", ColorMode::TrueColor);
+        assert_eq!(shown(&g), "a x字 ");
+        put_text(&mut g, 3, 0, "y", ColorMode::TrueColor);
+        assert_eq!(shown(&g), "a xy  ");
+    }
+
+    #[test]
+    fn bidi_and_format_characters_are_stripped() {
+        let mut g = blank(12, 1, ColorMode::Ascii);
+        put_line(
+            &mut g,
+            0,
+            "evil\u{202e}box\u{200b}\u{2066}",
+            ColorMode::Ascii,
+        );
+        assert_eq!(shown(&g), "evilbox     ");
+        assert_eq!(text_width("\u{202e}\u{feff}e\u{301}"), 1);
     }
 
     #[test]

@@ -1,39 +1,53 @@
-//! The only code that touches the terminal: raw mode and the alternate screen, the event loop,
-//! and the ways out. The terminal is restored on every exit path:
+//! The only code that touches the terminal: raw mode and the alternate screen (through
+//! [`tty`](super::tty)), the event loop, and the ways out. The terminal is restored on every
+//! exit path:
 //! - quit (Esc, Ctrl-C), an I/O error, or a dropped tty: [`Guard`]'s `Drop` as `run` returns;
-//! - a panic: the panic hook restores before the default hook prints the message;
+//! - a panic, on any thread: the panic hook restores before the default hook prints;
 //! - SIGTERM, SIGHUP, SIGINT, SIGQUIT: the signal thread turns them into a quit the loop sees
-//!   at once; if the loop is stuck (a write blocked on a stalled link) the signal thread
-//!   restores and exits itself after [`FORCED_EXIT_AFTER`].
+//!   at once (no write can hold it up: frames are written by the writer thread, non-blocking);
+//!   if the loop is busy (a long render) the signal thread restores and exits itself after
+//!   [`FORCED_EXIT_AFTER`], with the status the binary gives that signal.
 //!
-//! Idle means idle: with nothing to render the loop blocks on its channel. Input comes from a
-//! reader thread that stops on end-of-file or EIO, and from the signal thread.
+//! Idle means idle: with nothing to render or write the loop blocks on its channel. Input comes
+//! from a reader thread that stops on end-of-file or EIO, from the signal thread, and from the
+//! writer thread (a frame is written).
 
-use std::io::{self, IsTerminal, Read, Write};
-use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::io::{self, IsTerminal};
+use std::os::fd::{AsRawFd, RawFd};
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use crossterm::event::KeyEvent;
-use crossterm::{cursor, execute, terminal};
 use raytty::{ColorMode, Scene};
 use signal_hook::consts::{SIGHUP, SIGINT, SIGQUIT, SIGSTOP, SIGTERM, SIGWINCH};
 use signal_hook::iterator::Signals;
 
 use super::app::{App, Message, update};
-use super::input::KeyParser;
+use super::input::{ESC_DELAY, KeyParser};
 use super::keys::message_for;
+use super::tty;
 use super::view::{GI_MAX_PASSES, Screen};
 
 /// While refining, a new average is drawn at most this often: a few frames a second.
 const REFINE_DRAW_INTERVAL: Duration = Duration::from_millis(250);
 /// After a terminating signal the loop has this long to restore and exit before the signal
-/// thread does it (the loop may be blocked writing to a link that no longer drains).
-const FORCED_EXIT_AFTER: Duration = Duration::from_secs(2);
-/// Exit status for a dropped terminal, as if by SIGHUP (128 + 1).
-const HANGUP_STATUS: u8 = 129;
+/// thread does it. With [`tty::restore`]'s bounded drain the process is gone within 2 s.
+const FORCED_EXIT_AFTER: Duration = Duration::from_secs(1);
+/// The writer checks this often whether its frame is still wanted while the terminal takes
+/// nothing (a stalled link).
+const WRITER_POLL: Duration = Duration::from_millis(100);
+
+/// How the app ended; the binary turns it into an exit status.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// The user quit (Esc, Ctrl-C).
+    Quit,
+    /// A terminating signal arrived (its number).
+    Signal(i32),
+    /// The terminal went away (end-of-file or EIO on the tty).
+    Hangup,
+}
 
 /// What the loop waits for.
 enum Input {
@@ -44,103 +58,98 @@ enum Input {
     Hangup,
     /// A terminating signal.
     Signal(i32),
+    /// The writer is done with a frame (or could not write it).
+    Written(io::Result<()>),
 }
 
-/// Whether the terminal is in the app's modes and needs restoring.
-static ACTIVE: AtomicBool = AtomicBool::new(false);
-
-/// Puts the terminal back: main screen, cooked mode, cursor visible, colours reset. Safe to
-/// call from any thread, more than once, and on a terminal that is gone (errors are ignored).
-fn restore() {
-    if ACTIVE.swap(false, Ordering::SeqCst) {
-        let mut out = io::stdout();
-        // End any half-written synchronized frame and reset the pen before leaving.
-        let _ = out.write_all(b"\x1b[?2026l\x1b[0m");
-        let _ = execute!(out, cursor::Show, terminal::LeaveAlternateScreen);
-        let _ = terminal::disable_raw_mode();
-    }
+/// A frame for the writer, tagged with the terminal's epoch it was encoded for.
+struct Job {
+    epoch: u64,
+    bytes: Vec<u8>,
 }
 
 /// Holds the terminal in raw mode on the alternate screen; restores it when dropped.
 struct Guard;
 
 impl Guard {
-    fn enter() -> Result<Guard> {
+    fn enter(input: RawFd) -> Result<Guard> {
         let prev = std::panic::take_hook();
         std::panic::set_hook(Box::new(move |info| {
-            restore();
+            tty::restore();
             prev(info);
         }));
-        take_terminal()?;
-        Ok(Guard)
+        tty::open(input).context("cannot open the terminal")?;
+        let guard = Guard;
+        tty::take().context("cannot put the terminal in raw mode")?;
+        Ok(guard)
     }
 }
 
-/// Raw mode, the alternate screen, a hidden cursor and a clear screen; marks the terminal as
-/// needing [`restore`].
-fn take_terminal() -> Result<()> {
-    terminal::enable_raw_mode().context("cannot put the terminal in raw mode")?;
-    ACTIVE.store(true, Ordering::SeqCst);
-    execute!(
-        io::stdout(),
-        terminal::EnterAlternateScreen,
-        cursor::Hide,
-        terminal::Clear(terminal::ClearType::All)
-    )?;
-    Ok(())
+impl Drop for Guard {
+    fn drop(&mut self) {
+        tty::restore();
+    }
 }
 
 /// Ctrl-Z: gives the terminal back as it was, stops the process (as the shell's job control
 /// expects; SIGSTOP, because raw mode turned the key into a byte rather than SIGTSTP), and once
 /// continued (`fg`) takes the terminal again. The caller redraws every cell.
 fn suspend() -> Result<()> {
-    restore();
+    tty::restore();
     signal_hook::low_level::raise(SIGSTOP).context("cannot suspend")?;
-    take_terminal()
-}
-
-impl Drop for Guard {
-    fn drop(&mut self) {
-        restore();
-    }
+    tty::take().context("cannot take the terminal back")
 }
 
 /// Runs the app on the terminal until the user quits, the terminal goes away or a signal
-/// arrives. The exit code is 0 for a quit, 128 + N for signal N.
-pub fn run(scene: Scene, color: ColorMode) -> Result<ExitCode> {
-    let tty: Box<dyn Read + Send> = if io::stdin().is_terminal() {
-        Box::new(io::stdin())
+/// arrives, and says which.
+pub fn run(scene: Scene, color: ColorMode) -> Result<Outcome> {
+    let stdin = io::stdin();
+    let dev_tty;
+    let input: RawFd = if stdin.is_terminal() {
+        stdin.as_raw_fd()
     } else {
-        Box::new(std::fs::File::open("/dev/tty").context("cannot open /dev/tty to read keys")?)
+        dev_tty = std::fs::File::open("/dev/tty").context("cannot open /dev/tty to read keys")?;
+        dev_tty.as_raw_fd()
     };
     let (tx, rx) = mpsc::channel();
     let signals = Signals::new([SIGWINCH, SIGTERM, SIGHUP, SIGINT, SIGQUIT])
         .context("cannot install signal handlers")?;
-    let guard = Guard::enter()?;
+    let guard = Guard::enter(input)?;
     spawn_signal_thread(signals, tx.clone());
-    spawn_reader_thread(tty, tx);
-    let size = terminal::size().context("cannot read the terminal size")?;
-    let code = event_loop(App::new(scene, color, size), &rx);
+    spawn_reader_thread(input, tx.clone());
+    let writer = spawn_writer_thread(tx);
+    let size = tty::size().context("cannot read the terminal size")?;
+    let outcome = event_loop(App::new(scene, color, size), &rx, &writer);
     drop(guard);
-    code
+    outcome
 }
 
-fn spawn_reader_thread(mut tty: Box<dyn Read + Send>, tx: Sender<Input>) {
+/// Reads keys until end-of-file or an error. A lone ESC waits up to [`ESC_DELAY`] for the rest
+/// of a sequence a slow link may have split.
+fn spawn_reader_thread(fd: RawFd, tx: Sender<Input>) {
     std::thread::spawn(move || {
         let mut parser = KeyParser::default();
         let mut buf = [0u8; 1024];
         loop {
-            match tty.read(&mut buf) {
-                Ok(0) => break,
-                Ok(n) => {
-                    for k in parser.feed(&buf[..n]) {
-                        if tx.send(Input::Key(k)).is_err() {
-                            return;
-                        }
+            let wait = parser.waiting_on_escape().then_some(ESC_DELAY);
+            let keys = if tty::wait_readable(fd, wait) {
+                // SAFETY: reads into `buf`, within its length.
+                let n = unsafe { libc::read(fd, buf.as_mut_ptr().cast(), buf.len()) };
+                match n {
+                    0 => break,
+                    n if n > 0 => parser.feed(&buf[..n as usize]),
+                    _ if io::Error::last_os_error().kind() == io::ErrorKind::Interrupted => {
+                        continue;
                     }
+                    _ => break,
                 }
-                Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
-                Err(_) => break,
+            } else {
+                parser.timeout()
+            };
+            for k in keys {
+                if tx.send(Input::Key(k)).is_err() {
+                    return;
+                }
             }
         }
         let _ = tx.send(Input::Hangup);
@@ -159,81 +168,128 @@ fn spawn_signal_thread(mut signals: Signals, tx: Sender<Input>) {
             let _ = tx.send(Input::Signal(sig));
             // The loop should have restored and exited well before this.
             std::thread::sleep(FORCED_EXIT_AFTER);
-            restore();
-            std::process::exit(128 + sig);
+            tty::restore();
+            std::process::exit(crate::cli::signal_status(sig).into());
         }
     });
 }
 
-/// Applies one input; returns the exit code if it ends the app.
-fn handle(app: &mut App, input: Input) -> Option<ExitCode> {
+/// The writer: takes frames one at a time and writes each through the non-blocking descriptor,
+/// waiting for room as the terminal drains. A frame from before a suspend, or after a restore,
+/// is dropped. Reports each frame back to the loop.
+fn spawn_writer_thread(tx: Sender<Input>) -> Sender<Job> {
+    let (jobs, rx) = mpsc::channel::<Job>();
+    std::thread::spawn(move || {
+        for job in rx {
+            let report = write_frame(&job);
+            if tx.send(Input::Written(report)).is_err() {
+                return;
+            }
+        }
+    });
+    jobs
+}
+
+fn write_frame(job: &Job) -> io::Result<()> {
+    let fd = tty::writer_fd();
+    let mut rest = &job.bytes[..];
+    while !rest.is_empty() && tty::writable_in(job.epoch) {
+        match tty::write_some(fd, rest) {
+            Ok(n) => rest = &rest[n..],
+            Err(e) if e.kind() == io::ErrorKind::WouldBlock => {
+                tty::wait_writable(fd, WRITER_POLL);
+            }
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(())
+}
+
+/// Applies one input; returns the outcome if it ends the app.
+fn handle(app: &mut App, input: Input, busy: &mut bool) -> Result<Option<Outcome>> {
     match input {
         Input::Key(k) => {
             if let Some(m) = message_for(k) {
                 update(app, m);
             }
-            app.quit.then_some(ExitCode::SUCCESS)
+            return Ok(app.quit.then_some(Outcome::Quit));
         }
         Input::Resize => {
-            if let Ok((cols, rows)) = terminal::size() {
+            if let Ok((cols, rows)) = tty::size() {
                 update(app, Message::Resize { cols, rows });
             }
-            None
         }
-        Input::Hangup => Some(ExitCode::from(HANGUP_STATUS)),
-        Input::Signal(s) => Some(ExitCode::from(128 + s as u8)),
+        Input::Hangup => return Ok(Some(Outcome::Hangup)),
+        Input::Signal(s) => return Ok(Some(Outcome::Signal(s))),
+        Input::Written(report) => {
+            *busy = false;
+            report.context("cannot write to the terminal")?;
+        }
     }
+    Ok(None)
 }
 
-fn event_loop(mut app: App, rx: &Receiver<Input>) -> Result<ExitCode> {
+fn event_loop(mut app: App, rx: &Receiver<Input>, writer: &Sender<Job>) -> Result<Outcome> {
     let mut screen = Screen::new();
-    let mut out = io::stdout().lock();
     let mut last_draw = Instant::now();
+    // A frame is with the writer.
+    let mut busy = false;
+    // The image or the app changed since the last frame was encoded.
+    let mut stale = true;
     loop {
-        if !app.dirty && !screen.needs_render(&app) {
-            // Idle: block until a key, a resize or a signal.
+        let can_draw = stale && !busy;
+        if !screen.needs_render(&app) && !can_draw {
+            // Idle: block until a key, a resize, a signal or the writer.
             let Ok(input) = rx.recv() else {
-                return Ok(ExitCode::from(HANGUP_STATUS));
+                return Ok(Outcome::Hangup);
             };
-            if let Some(code) = handle(&mut app, input) {
-                return Ok(code);
+            if let Some(outcome) = handle(&mut app, input, &mut busy)? {
+                return Ok(outcome);
             }
         }
         // Drain everything pending, so a held key never queues frames behind it.
         while let Ok(input) = rx.try_recv() {
-            if let Some(code) = handle(&mut app, input) {
-                return Ok(code);
+            if let Some(outcome) = handle(&mut app, input, &mut busy)? {
+                return Ok(outcome);
             }
         }
+        if app.dirty {
+            stale = true;
+            app.dirty = false;
+        }
         if app.suspend {
-            out.flush().context("cannot write to the terminal")?;
             suspend()?;
             app.suspend = false;
             // The terminal may have been resized, and shows whatever ran meanwhile.
-            if let Ok((cols, rows)) = terminal::size() {
+            if let Ok((cols, rows)) = tty::size() {
                 update(&mut app, Message::Resize { cols, rows });
             }
             screen.forget_shown();
-            app.dirty = true;
+            stale = true;
         }
         if screen.needs_render(&app) {
             screen.render(&app);
-            let refined = screen.passes() > 1;
-            if refined
-                && !app.dirty
-                && screen.passes() < GI_MAX_PASSES
-                && last_draw.elapsed() < REFINE_DRAW_INTERVAL
-            {
-                continue;
-            }
+            // A refinement pass is drawn at most every REFINE_DRAW_INTERVAL, and the last one.
+            stale |= screen.passes() <= 1
+                || screen.passes() >= GI_MAX_PASSES
+                || last_draw.elapsed() >= REFINE_DRAW_INTERVAL;
         }
-        let bytes = screen.draw(&app);
-        app.dirty = false;
-        last_draw = Instant::now();
-        if !bytes.is_empty() {
-            out.write_all(&bytes)
-                .context("cannot write to the terminal")?;
-            out.flush().context("cannot write to the terminal")?;
+        if stale && !busy {
+            stale = false;
+            last_draw = Instant::now();
+            let bytes = screen.draw(&app);
+            if !bytes.is_empty() {
+                let job = Job {
+                    epoch: tty::epoch(),
+                    bytes,
+                };
+                writer
+                    .send(job)
+                    .map_err(|_| io::Error::other("the writer stopped"))
+                    .context("cannot write to the terminal")?;
+                busy = true;
+            }
         }
     }
 }

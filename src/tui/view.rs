@@ -8,7 +8,7 @@ use glam::Vec3;
 use raytty::{CellGrid, FrameStats, HitCache, Image, Stage, encode_diff, printable, render_cached};
 
 use super::app::App;
-use super::overlay::{blank, draw_help, put_line, put_text};
+use super::overlay::{blank, draw_help, put_line, put_text, text_width};
 
 /// Smallest terminal drawn: below this a short message replaces the frame.
 pub const MIN_COLS: u16 = 10;
@@ -110,7 +110,7 @@ impl Screen {
             self.passes = 0;
             self.sum.clear();
         }
-        let mut settings = app.stage.settings(app.scene.effects);
+        let mut settings = app.stage.settings(app.scene.effects());
         settings.frame = self.passes;
         let frame = render_cached(
             &app.scene,
@@ -189,7 +189,7 @@ impl Screen {
         let light = app.light().map_or_else(|| "none".into(), xyz);
         // (text, rank): rank 0 is always shown, then the lowest ranks first while they fit.
         let fields = [
-            (printable(&app.scene.name), 0),
+            (printable(app.scene.name()), 0),
             (format!("{key}:{}{spp}", app.stage.name()), 0),
             (
                 format!(
@@ -210,7 +210,7 @@ impl Screen {
     }
 }
 
-/// Joins `fields` (text, rank) into a status line of at most `width` characters where
+/// Joins `fields` (text, rank) into a status line of at most `width` columns where
 /// possible: fields are taken by rank, lowest first, each one only if the line still fits
 /// with it; the fields kept stay in their order. Rank-0 fields are always kept (the line is
 /// clipped when drawn instead).
@@ -229,18 +229,18 @@ fn fit_status(fields: &[(String, u8)], width: usize) -> String {
     by_rank.sort_by_key(|&i| fields[i].1);
     for i in by_rank {
         keep[i] = true;
-        if line(&keep).chars().count() > width {
+        if text_width(&line(&keep)) > width {
             keep[i] = false;
         }
     }
     line(&keep)
 }
 
-/// The first of `variants` (longest first) that fits in `width` characters, else the last.
+/// The first of `variants` (longest first) that fits in `width` columns, else the last.
 fn longest_that_fits<'a>(variants: &[&'a str], width: usize) -> &'a str {
     variants
         .iter()
-        .find(|v| v.chars().count() <= width)
+        .find(|v| text_width(v) <= width)
         .or(variants.last())
         .copied()
         .unwrap_or("")
@@ -414,6 +414,34 @@ mod tests {
             let out = s.draw(&a);
             assert_eq!(out.is_empty(), c == 0 || r == 0, "{c}x{r}");
         }
+    }
+
+    /// An app showing a one-box scene called `name`.
+    fn named(name: &str, cols: u16, rows: u16) -> App {
+        let source = format!(
+            "name = \"{name}\"\n[material.m]\ncolour = [1, 1, 1]\n[[object]]\nkind = \"box\"\nmaterial = \"m\"\ncentre = [0, 0, 0]\nsize = [1, 1, 1]\n"
+        );
+        let scene =
+            raytty::scene::file::parse(&source, "t.toml", "t", &raytty::scene::file::no_meshes)
+                .unwrap();
+        App::new(scene, ColorMode::TrueColor, (cols, rows))
+    }
+
+    #[test]
+    fn a_wide_name_is_measured_in_columns() {
+        let a = named(&"漢".repeat(200), 40, 5);
+        let s = Screen::new();
+        let line = s.status(&a);
+        assert!(line.starts_with(" 漢漢"), "{line:?}");
+        // Only the rank-0 fields: the name is clipped when drawn, never wrapped.
+        assert!(!line.contains("H:help"), "{line:?}");
+        let a = named("漢字", 40, 5);
+        let line = s.status(&a);
+        assert!(
+            text_width(&line) <= 40 && line.contains("H:help"),
+            "{line:?}"
+        );
+        assert!(text_width(&line) > line.chars().count());
     }
 
     #[test]

@@ -74,9 +74,9 @@ pub struct Reference {
 impl Reference {
     /// The reference of `scene`.
     pub fn new(scene: &Scene) -> Reference {
-        let tris = scene.triangles.iter().map(|t| super::d3(&t.v)).collect();
+        let tris = scene.triangles().iter().map(|t| super::d3(&t.v)).collect();
         let normals = scene
-            .triangles
+            .triangles()
             .iter()
             .map(|t| {
                 let [a, b, c] = super::d3(&t.v);
@@ -84,18 +84,18 @@ impl Reference {
             })
             .collect();
         let colours = scene
-            .triangles
+            .triangles()
             .iter()
-            .map(|t| scene.materials[t.material as usize].colour.as_dvec3())
+            .map(|t| scene.materials()[t.material as usize].colour.as_dvec3())
             .collect();
         let r = scene.min_light_distance() as f64;
         Reference {
             tris,
             normals,
             colours,
-            edges: feature_edges(&scene.triangles),
+            edges: feature_edges(scene.triangles()),
             min_r2: r * r,
-            extent: scene.extent as f64,
+            extent: scene.extent() as f64,
         }
     }
 

@@ -4,9 +4,9 @@
 use glam::Vec3;
 use toml::Spanned;
 
-use super::MAX_COORDINATE;
 use super::error::{SceneFileError, did_you_mean};
 use super::spec::Three;
+use crate::scene::MAX_COORDINATE;
 
 /// How each required key is written, for "missing key" messages.
 const KEY_FORMS: [(&str, &str); 6] = [
@@ -43,7 +43,7 @@ impl Ctx<'_> {
     /// `v` as an `f32` triple, each component finite and within ±[`MAX_COORDINATE`].
     pub fn point(&self, v: &Spanned<Three<f64>>, what: &str) -> Result<Vec3, SceneFileError> {
         for c in &v.get_ref().0 {
-            if !c.is_finite() || c.abs() > MAX_COORDINATE {
+            if !c.is_finite() || c.abs() > f64::from(MAX_COORDINATE) {
                 return Err(self.err_at(
                     v,
                     format!(

@@ -42,6 +42,18 @@ impl SceneFileError {
         message: impl Into<String>,
     ) -> Self {
         let whole = text.split('\n').nth(line.saturating_sub(1)).unwrap_or("");
+        SceneFileError::on_line(file, whole, line, column, message)
+    }
+
+    /// An error at 1-based `column` (in characters) of `whole`, which is line `line` of the
+    /// file: for callers that hold the file as bytes and convert only the line shown.
+    pub fn on_line(
+        file: &str,
+        whole: &str,
+        line: usize,
+        column: usize,
+        message: impl Into<String>,
+    ) -> Self {
         // Tabs become spaces so that the caret stays under the column.
         let chars: Vec<char> = whole
             .chars()
@@ -113,35 +125,9 @@ pub fn line_column(source: &str, offset: usize) -> (usize, usize) {
     (line, before[line_start..].chars().count() + 1)
 }
 
-/// The edit distance between `a` and `b` (insertions, deletions, substitutions and swaps of
-/// two neighbours each cost 1).
-pub fn edit_distance(a: &str, b: &str) -> usize {
-    let a: Vec<char> = a.chars().collect();
-    let b: Vec<char> = b.chars().collect();
-    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
-    for (i, row) in d.iter_mut().enumerate() {
-        row[0] = i;
-    }
-    for (j, cell) in d[0].iter_mut().enumerate() {
-        *cell = j;
-    }
-    for i in 1..=a.len() {
-        for j in 1..=b.len() {
-            let cost = usize::from(a[i - 1] != b[j - 1]);
-            let mut best = (d[i - 1][j] + 1)
-                .min(d[i][j - 1] + 1)
-                .min(d[i - 1][j - 1] + cost);
-            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
-                best = best.min(d[i - 2][j - 2] + 1);
-            }
-            d[i][j] = best;
-        }
-    }
-    d[a.len()][b.len()]
-}
-
-/// The known name closest to `word`, if it is close enough to be a likely typo: at most 2 edits,
-/// and fewer than half of the word's characters.
+/// The known name closest to `word`, if it is close enough to be a likely typo: at most 2 edits
+/// (insertions, deletions, substitutions, swaps of two neighbours: `strsim`'s optimal string
+/// alignment distance), and fewer than half of the word's characters.
 pub fn suggest<'a>(word: &str, known: &[&'a str]) -> Option<&'a str> {
     // Typos longer than this are not worth comparing (and keep the quadratic distance cheap).
     const LONGEST: usize = 64;
@@ -151,7 +137,7 @@ pub fn suggest<'a>(word: &str, known: &[&'a str]) -> Option<&'a str> {
     let limit = 2.min(word.chars().count().div_ceil(2));
     known
         .iter()
-        .map(|k| (edit_distance(&word.to_lowercase(), k), *k))
+        .map(|k| (strsim::osa_distance(&word.to_lowercase(), k), *k))
         .filter(|&(d, _)| d <= limit)
         .min_by_key(|&(d, _)| d)
         .map(|(_, k)| k)
@@ -204,6 +190,8 @@ mod tests {
         assert_eq!(suggest("Colour", &known), Some("colour"));
         assert_eq!(suggest("size", &known), None);
         assert_eq!(suggest("m", &known), None);
-        assert_eq!(edit_distance("ab", "ba"), 1);
+        // A swap of two neighbours is one edit.
+        assert_eq!(suggest("mirorr", &["mirror", "morrir"]), Some("mirror"));
+        assert_eq!(suggest("clouor", &known), Some("colour"));
     }
 }

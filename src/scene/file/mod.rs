@@ -16,13 +16,10 @@ mod spec;
 use std::io::Read;
 use std::path::Path;
 
-pub use error::{SceneFileError, did_you_mean, edit_distance, line_column, suggest};
+pub use error::{SceneFileError, did_you_mean, line_column, suggest};
 
 use crate::scene::Scene;
 
-/// Largest absolute coordinate accepted anywhere (positions, vertices, box corners, after
-/// transforms): far beyond any sensible scene, far below where `f32` loses whole units.
-pub const MAX_COORDINATE: f64 = 1e6;
 /// Most triangles a scene may have, meshes included (about 200 MB of triangles and BVH).
 pub const MAX_TRIANGLES: usize = 2_000_000;
 /// Most vertices an OBJ mesh may define.
@@ -91,6 +88,8 @@ pub fn parse(
     name: &str,
     read_mesh: MeshReader,
 ) -> Result<Scene, SceneFileError> {
+    // A byte order mark (Windows editors write one) is not part of the first line.
+    let source = source.strip_prefix('\u{FEFF}').unwrap_or(source);
     build::build(source, file, name, read_mesh)
 }
 

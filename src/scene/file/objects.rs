@@ -10,7 +10,8 @@ use super::error::{SceneFileError, did_you_mean};
 use super::spec::{NumberOrTriple, ObjectSpec};
 use super::*;
 use crate::geometry::Triangle;
-use crate::scene::obj::parse_obj;
+use crate::scene::MAX_COORDINATE;
+use crate::scene::obj::{line_text, parse_obj};
 use crate::scene::procedural::{displaced_icosphere, icosphere_triangles};
 
 /// The object kinds and the keys each one takes besides `kind`, `material` and the transform.
@@ -226,9 +227,9 @@ fn mesh(
         )
     })?;
     let mesh = parse_obj(&bytes, budget, MAX_MESH_VERTICES).map_err(|e| {
-        SceneFileError::at_line(
+        SceneFileError::on_line(
             &shown,
-            &String::from_utf8_lossy(&bytes),
+            &line_text(&bytes, e.line),
             e.line,
             e.column,
             format!(
@@ -280,7 +281,7 @@ fn icosphere(
 fn triangle_problem([a, b, c]: [Vec3; 3], transformed: bool) -> Option<String> {
     if [a, b, c]
         .iter()
-        .any(|v| !(v.abs().max_element() <= MAX_COORDINATE as f32))
+        .any(|v| !(v.abs().max_element() <= MAX_COORDINATE))
     {
         return Some(if transformed {
             format!(
