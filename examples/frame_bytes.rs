@@ -65,6 +65,7 @@ fn main() {
             let mut out = Vec::new();
             encode_diff(prev.as_ref(), &grid, 0, &mut out);
             let enc = start.elapsed();
+
             // The first frame is the full paint; the sweep is the frames after it.
             if step > 0 {
                 diff_bytes += out.len();
@@ -87,11 +88,12 @@ fn main() {
         }
         let n = STEPS as f64;
         println!(
-            "{sweep}: {:.0} bytes/frame diffed vs {:.0} naive ({:.1}%), {:.0}% of cells changed, render {:.1} ms, encode {:.2} ms, primary rays/frame {}",
+            "{sweep}: {:.0} bytes/frame diffed vs {:.0} naive ({:.1}%), {:.0}% of cells changed ({:.1} B each), render {:.1} ms, encode {:.2} ms, primary rays/frame {}",
             diff_bytes as f64 / n,
             naive_bytes as f64 / n,
             100.0 * diff_bytes as f64 / naive_bytes as f64,
             100.0 * changed as f64 / (n * (COLS * (ROWS - 1)) as f64),
+            diff_bytes as f64 / changed as f64,
             render_t.as_secs_f64() * 1e3 / n,
             encode_t.as_secs_f64() * 1e3 / n,
             primary / STEPS as u64,

@@ -1,4 +1,5 @@
-//! Linear float images and their 8-bit, PNG and PFM forms.
+//! Linear float images and their 8-bit, PNG and PFM forms (PFM both written and read: the
+//! bench caches its references as PFM).
 
 use std::io::{self, Write};
 
@@ -68,6 +69,72 @@ impl Image {
     }
 }
 
+impl Image {
+    /// Reads a colour PFM as [`Image::write_pfm`] writes it: `PF`, width, height, a negative
+    /// scale (little-endian), then exactly width × height pixels of three `f32`, bottom row
+    /// first. Anything else (another format, a header out of range, too few or too many bytes)
+    /// is an `InvalidData` error saying what is wrong; nothing is allocated before the size
+    /// is checked against the bytes there are.
+    pub fn read_pfm(bytes: &[u8]) -> io::Result<Image> {
+        let invalid = |why: String| io::Error::new(io::ErrorKind::InvalidData, why);
+        // Four header tokens, each ended by one whitespace byte: PF, width, height, scale.
+        let mut pos = 0;
+        let mut token = || -> Option<&[u8]> {
+            while bytes.get(pos)?.is_ascii_whitespace() {
+                pos += 1;
+            }
+            let start = pos;
+            while !bytes.get(pos)?.is_ascii_whitespace() {
+                pos += 1;
+            }
+            pos += 1;
+            Some(&bytes[start..pos - 1])
+        };
+        let mut field = |what: &str| {
+            token()
+                .and_then(|t| std::str::from_utf8(t).ok())
+                .map(str::to_string)
+                .ok_or_else(|| invalid(format!("the header ends before its {what}")))
+        };
+        if field("PF")? != "PF" {
+            return Err(invalid(
+                "not a colour PFM (it does not start with PF)".into(),
+            ));
+        }
+        let size = |t: String, what: &str| match t.parse::<u32>() {
+            Ok(n) if n > 0 => Ok(n),
+            _ => Err(invalid(format!(
+                "its {what} `{t}` is not a whole number from 1 up"
+            ))),
+        };
+        let width = size(field("width")?, "width")?;
+        let height = size(field("height")?, "height")?;
+        let scale = field("scale")?;
+        if !scale.parse::<f32>().is_ok_and(|s| s < 0.0) {
+            return Err(invalid(format!(
+                "its scale `{scale}` is not negative (only little-endian PFM is read)"
+            )));
+        }
+        let data = &bytes[pos.min(bytes.len())..];
+        // In u128, where 12·(2³² − 1)² cannot overflow.
+        let expected = u128::from(width) * u128::from(height) * 12;
+        if data.len() as u128 != expected {
+            return Err(invalid(format!(
+                "it holds {} bytes of pixels where {width}x{height} needs {expected}",
+                data.len()
+            )));
+        }
+        let mut img = Image::new(width, height);
+        let w = width as usize;
+        for (i, px) in data.chunks_exact(12).enumerate() {
+            let f = |k: usize| f32::from_le_bytes([px[k], px[k + 1], px[k + 2], px[k + 3]]);
+            let y = height as usize - 1 - i / w;
+            img.pixels[y * w + i % w] = Vec3::new(f(0), f(4), f(8));
+        }
+        Ok(img)
+    }
+}
+
 /// One linear pixel to 8 bits: clamp to [0, 1], scale by 255, round to nearest.
 #[inline]
 pub fn to_rgb8(p: Vec3) -> [u8; 3] {
@@ -90,7 +157,7 @@ fn png_io_error(e: png::EncodingError) -> io::Error {
 }
 
 #[cfg(test)]
-mod png_tests {
+mod tests {
     use super::*;
 
     /// A writer whose reader has gone away.
@@ -102,6 +169,52 @@ mod png_tests {
         }
         fn flush(&mut self) -> io::Result<()> {
             Ok(())
+        }
+    }
+
+    fn pfm(img: &Image) -> Vec<u8> {
+        let mut out = Vec::new();
+        img.write_pfm(&mut out).unwrap();
+        out
+    }
+
+    #[test]
+    fn pfm_round_trips() {
+        let mut img = Image::new(3, 2);
+        for (i, p) in img.pixels.iter_mut().enumerate() {
+            *p = Vec3::new(i as f32, 0.5 * i as f32, -1.25);
+        }
+        assert_eq!(Image::read_pfm(&pfm(&img)).unwrap(), img);
+    }
+
+    #[test]
+    fn a_corrupt_pfm_is_refused_with_a_reason() {
+        let refused = |bytes: &[u8]| {
+            let e = Image::read_pfm(bytes).unwrap_err();
+            assert_eq!(e.kind(), io::ErrorKind::InvalidData);
+            e.to_string()
+        };
+        assert!(refused(b"P6\n1 1\n255\n...").contains("PF"));
+        assert!(refused(b"").contains("header ends"));
+        assert!(refused(b"PF\n2 2").contains("header ends"));
+        assert!(refused(b"PF\n2 2\n1.0\n").contains("little-endian"));
+        assert!(refused(b"PF\n0 2\n-1.0\n").contains("width `0`"));
+        assert!(refused(b"PF\n-2 2\n-1.0\n").contains("width `-2`"));
+        assert!(refused(b"PF\n2 99999999999\n-1.0\n").contains("height"));
+        // Truncated, or with bytes to spare.
+        let good = pfm(&Image::new(3, 2));
+        assert!(refused(&good[..good.len() - 1]).contains("needs 72"));
+        assert!(refused(&[&good[..], b"x"].concat()).contains("needs 72"));
+        assert!(refused(b"PF\n2 2\n-1.0\n").contains("holds 0 bytes"));
+        // Sizes whose byte count overflows 32 or 64 bits are refused, not allocated.
+        for header in [
+            "PF\n4294967295 4294967295\n-1.0\n",
+            "PF\n2147483648 2147483648\n-1.0\n",
+            "PF\n65536 65536\n-1.0\n",
+        ] {
+            let mut bytes = header.as_bytes().to_vec();
+            bytes.extend_from_slice(&[0; 24]);
+            assert!(refused(&bytes).contains("bytes of pixels"), "{header}");
         }
     }
 

@@ -1,5 +1,4 @@
-//! The render loop: primary rays for every pixel, in 8×8 tiles (bands of tiles in parallel),
-//! shaded by [`Tracer`].
+//! The render loop: primary rays for every pixel, rows in parallel, shaded by [`Tracer`].
 //!
 //! A frame's pixels depend only on (scene, camera, lights, settings, size): each sample's random
 //! numbers are seeded from (pixel, sample, frame), and the ray counts are integer sums, so the
@@ -12,6 +11,7 @@ use rayon::prelude::*;
 
 use crate::accel::Hit;
 use crate::camera::Camera;
+use crate::denoise::{GuidePixel, Guides};
 use crate::image::Image;
 use crate::rng::Rng;
 use crate::scene::{PointLight, Scene};
@@ -35,6 +35,9 @@ pub struct Frame {
     pub image: Image,
     /// What it cost.
     pub stats: FrameStats,
+    /// The denoiser's guide buffers: only from [`render_guided`] with path-traced indirect
+    /// light.
+    pub guides: Option<Guides>,
 }
 
 /// The primary hits of the last frame, reused while the camera, size and geometry stay the
@@ -99,12 +102,70 @@ pub fn render_cached(
     height: u32,
     cache: &mut HitCache,
 ) -> Frame {
+    render_impl(scene, camera, lights, settings, width, height, cache, false)
+}
+
+/// [`render_cached`], and with path-traced indirect light the denoiser's guide buffers too
+/// ([`Frame::guides`]). The image is the same as [`render_cached`]'s.
+pub fn render_guided(
+    scene: &Scene,
+    camera: &Camera,
+    lights: &[PointLight],
+    settings: &Settings,
+    width: u32,
+    height: u32,
+    cache: &mut HitCache,
+) -> Frame {
+    render_impl(scene, camera, lights, settings, width, height, cache, true)
+}
+
+/// One sample through `ray`. A path-traced frame's sample is split (the same colour either
+/// way, but one way of computing it, so that guided and plain frames agree bit for bit), and
+/// its parts are added to `guide` when the frame keeps guides.
+#[inline]
+fn sample(
+    tracer: &Tracer,
+    ray: &crate::geometry::Ray,
+    hit: Option<Hit>,
+    rng: &mut Rng,
+    n: &mut RayCounts,
+    guide: Option<&mut GuidePixel>,
+) -> Vec3 {
+    if !tracer.splits() {
+        return tracer.shade_primary(ray, hit, rng, n);
+    }
+    let s = tracer.sample_primary(ray, hit, rng, n);
+    if let Some(g) = guide {
+        g.add(&s);
+    }
+    s.colour()
+}
+
+#[allow(clippy::too_many_arguments)]
+fn render_impl(
+    scene: &Scene,
+    camera: &Camera,
+    lights: &[PointLight],
+    settings: &Settings,
+    width: u32,
+    height: u32,
+    cache: &mut HitCache,
+    guided: bool,
+) -> Frame {
     let start = Instant::now();
     let samples = settings.effects.samples.max(1);
     let tracer = Tracer::new(scene, lights, *settings);
     let rays = camera.rays(width, height);
     let (w, h) = (width as usize, height as usize);
     let mut image = Image::new(width, height);
+    // Path-traced frames split every sample for the denoiser (same colour, in any case).
+    let split = tracer.splits();
+    let mut guides = (guided && split).then(|| Guides {
+        width,
+        height,
+        samples,
+        pixels: vec![GuidePixel::default(); w * h],
+    });
     if w == 0 || h == 0 {
         return Frame {
             image,
@@ -112,8 +173,14 @@ pub fn render_cached(
                 samples,
                 ..FrameStats::default()
             },
+            guides,
         };
     }
+    // Rows of guide pixels, or none: zipped with the image's rows, `None` rows for none.
+    let mut guide_rows: Vec<Option<&mut [GuidePixel]>> = match guides.as_mut() {
+        Some(g) => g.pixels.chunks_mut(w).map(Some).collect(),
+        None => (0..h).map(|_| None).collect(),
+    };
 
     let key = Some((camera_key(camera), width, height));
     let counts = if samples == 1 {
@@ -123,20 +190,22 @@ pub fn render_cached(
         }
         let counts = image
             .pixels
-            .par_chunks_mut(w * TILE)
-            .zip(cache.hits.par_chunks_mut(w * TILE))
+            .par_chunks_mut(w)
+            .zip(cache.hits.par_chunks_mut(w))
+            .zip(guide_rows.par_iter_mut())
             .enumerate()
-            .map(|(band, (pixels, hits))| {
+            .map(|(y, ((row, hits), guide_row))| {
                 let mut n = RayCounts::default();
-                for_each_in_tiles(band, w, pixels.len(), |x, y, i| {
+                for (x, (px, hit)) in row.iter_mut().zip(hits.iter_mut()).enumerate() {
                     let ray = rays.ray(x as f32 + 0.5, y as f32 + 0.5);
                     if !reuse {
                         n.primary += 1;
-                        hits[i] = scene.intersect(&ray, f32::INFINITY);
+                        *hit = scene.intersect(&ray, f32::INFINITY);
                     }
                     let mut rng = Rng::for_sample((y * w + x) as u64, 0, settings.frame);
-                    pixels[i] = tracer.shade_primary(&ray, hits[i], &mut rng, &mut n);
-                });
+                    let g = guide_row.as_mut().map(|r| &mut r[x]);
+                    *px = sample(&tracer, &ray, *hit, &mut rng, &mut n, g);
+                }
                 n
             })
             .reduce(RayCounts::default, sum);
@@ -147,11 +216,12 @@ pub fn render_cached(
         let square = strata * strata == samples;
         image
             .pixels
-            .par_chunks_mut(w * TILE)
+            .par_chunks_mut(w)
+            .zip(guide_rows.par_iter_mut())
             .enumerate()
-            .map(|(band, pixels)| {
+            .map(|(y, (row, guide_row))| {
                 let mut n = RayCounts::default();
-                for_each_in_tiles(band, w, pixels.len(), |x, y, i| {
+                for (x, px) in row.iter_mut().enumerate() {
                     let mut acc = Vec3::ZERO;
                     for s in 0..samples {
                         let mut rng = Rng::for_sample((y * w + x) as u64, s, settings.frame);
@@ -168,10 +238,14 @@ pub fn render_cached(
                         let ray = rays.ray(x as f32 + ox, y as f32 + oy);
                         n.primary += 1;
                         let hit = scene.intersect(&ray, f32::INFINITY);
-                        acc += tracer.shade_primary(&ray, hit, &mut rng, &mut n);
+                        let g = guide_row.as_mut().map(|r| &mut r[x]);
+                        acc += sample(&tracer, &ray, hit, &mut rng, &mut n, g);
                     }
-                    pixels[i] = acc / samples as f32;
-                });
+                    *px = acc / samples as f32;
+                    if let Some(r) = guide_row.as_mut() {
+                        r[x].scale(1.0 / samples as f32);
+                    }
+                }
                 n
             })
             .reduce(RayCounts::default, sum)
@@ -183,25 +257,7 @@ pub fn render_cached(
             samples,
             elapsed: start.elapsed(),
         },
-    }
-}
-
-/// Side of the square tiles the frame is rendered in: a band of `TILE` rows is one parallel
-/// task, walked tile by tile so that neighbouring rays (which visit the same nodes and
-/// triangles) follow each other.
-pub const TILE: usize = 8;
-
-/// Calls `f(x, y, i)` for the pixels of band `band` (rows `band·TILE..`) of a `w`-wide frame,
-/// whose slice holds `len` pixels, tile by tile; `i` is the index in the band's slice.
-#[inline(always)]
-fn for_each_in_tiles(band: usize, w: usize, len: usize, mut f: impl FnMut(usize, usize, usize)) {
-    let rows = len / w;
-    for x0 in (0..w).step_by(TILE) {
-        for dy in 0..rows {
-            for x in x0..(x0 + TILE).min(w) {
-                f(x, band * TILE + dy, dy * w + x);
-            }
-        }
+        guides,
     }
 }
 

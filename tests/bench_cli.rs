@@ -37,8 +37,8 @@ fn text(b: &[u8]) -> String {
 }
 
 /// Rows per size: 5 seed stages, AA at 4 and 16 spp, GI at 4 bounce counts × the quick ladder
-/// (1 and 4 spp).
-const ROWS_PER_SIZE: usize = 5 + 2 + 4 * 2;
+/// (1 and 4 spp), then stage 6 raw and denoised at 1 and 4 spp.
+const ROWS_PER_SIZE: usize = 5 + 2 + 4 * 2 + 2 * 2;
 const SIZES: usize = 2;
 
 /// The throughput section's table: header, alignment, and one row per ray kind (the quick
@@ -69,6 +69,14 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
             assert!(rate.parse::<f64>().is_ok_and(|r| r > 0.0), "{row}");
         }
     }
+    assert_eq!(
+        table
+            .iter()
+            .filter(|l| l.contains("| GI + denoiser |"))
+            .count(),
+        2 * SIZES
+    );
+    assert_eq!(stdout.matches("\n- GI + denoiser at ").count(), SIZES);
     let header: Vec<&str> = table[0]
         .trim_matches('|')
         .split('|')
@@ -141,6 +149,27 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
     assert!(again.status.success());
     assert!(text(&again.stdout).contains("read from the cache"));
     assert!(text(&again.stderr).contains("read from the cache"));
+    // A corrupt cache file (a header whose size overflows) is refused with a message on
+    // stderr, and rendered again.
+    let file = std::fs::read_dir(&cache)
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    std::fs::write(&file, "PF\n4294967295 4294967295\n-1.0\n\0\0\0\0").unwrap();
+    let repaired = bench(&dir.0, &[]);
+    let stderr = text(&repaired.stderr);
+    assert!(repaired.status.success(), "{stderr}");
+    let name = file.file_name().unwrap().to_string_lossy().into_owned();
+    assert!(
+        stderr
+            .lines()
+            .any(|l| l.contains(&name) && l.contains("refused") && l.contains("bytes of pixels")),
+        "{stderr}"
+    );
+    assert!(stderr.contains("rendered in"), "{stderr}");
+    assert!(std::fs::metadata(&file).unwrap().len() > 40 * 16 * 12);
 }
 
 #[test]
@@ -216,9 +245,11 @@ fn the_svg_is_well_formed_with_one_polyline_per_bounce_count() {
     assert!(svg.starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\""));
     let names = elements(&svg);
     assert_eq!(names[0], "svg");
-    assert_eq!(names.iter().filter(|n| *n == "polyline").count(), 4 * SIZES);
-    for b in [1, 2, 4, 8] {
-        let tag = format!("data-bounces=\"{b}\" points=\"");
+    // Raw GI at 1, 2, 4, 8 and stage 6's roulette cap (16) bounces, and GI + denoiser.
+    assert_eq!(names.iter().filter(|n| *n == "polyline").count(), 6 * SIZES);
+    assert_eq!(svg.matches("polyline class=\"denoised\"").count(), SIZES);
+    for b in [1, 2, 4, 8, 16] {
+        let tag = format!("class=\"gi\" data-bounces=\"{b}\" points=\"");
         let lines: Vec<&str> = svg.lines().filter(|l| l.contains(&tag)).collect();
         assert_eq!(lines.len(), SIZES, "{b} bounces");
         for l in lines {

@@ -467,6 +467,7 @@ unsafe fn occluded_avx2(bvh: &Bvh, ray: &Ray, t_max: f32) -> bool {
 mod tests {
     use super::*;
     use crate::accel::shrunk_t_max;
+    use crate::geometry::Aabb;
 
     #[test]
     fn shrunk_t_max_is_above_best_and_capped() {
@@ -476,7 +477,7 @@ mod tests {
     }
 
     #[test]
-    fn both_slab_tests_agree() {
+    fn every_slab_test_agrees_bit_for_bit() {
         // Random boxes and rays, with axis-parallel rays and origins on slab planes mixed in
         // (the NaN cases), compared bit for bit.
         let mut rng = crate::rng::Rng::seeded(5);
@@ -512,6 +513,16 @@ mod tests {
                     .enter_portable(&o, &inv, t_max)
                     .map(|t| t.map(f32::to_bits));
                 assert_eq!(a, b, "{ray:?} {t_max} {pair:?}");
+                // Both are held to the one slab test, `Aabb::enter`.
+                let c = [0, 1].map(|k| {
+                    Aabb {
+                        min: lo[k],
+                        max: hi[k],
+                    }
+                    .enter(&ray, t_max)
+                    .map(f32::to_bits)
+                });
+                assert_eq!(a, c, "{ray:?} {t_max} {pair:?}");
             }
         }
     }

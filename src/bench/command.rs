@@ -135,6 +135,9 @@ pub fn run_command(
         options.cache_dir.display()
     )))?;
     for r in &report.references {
+        for note in &r.refused {
+            writeln!(log, "raytty bench: {note}").map_err(io_error("stderr"))?;
+        }
         writeln!(log, "raytty bench: {}", r.describe()).map_err(io_error("stderr"))?;
     }
     let mut table = markdown(&report, &request.command);

@@ -19,11 +19,12 @@ use std::io;
 use std::path::PathBuf;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
+use crate::denoise::render_denoised;
 use crate::frame::{CellGrid, ColorMode, encode_text};
 use crate::image::Image;
 use crate::render::render;
 use crate::scene::{Effects, Indirect, Scene};
-use crate::shading::{Mode, RayCounts, Settings, Stage};
+use crate::shading::{GI_MAX_BOUNCES, Mode, RayCounts, Settings, Stage};
 
 pub use command::{BenchError, BenchRequest, check_sizes, run_command};
 pub use output::{csv, markdown, rewrite_readme, svg};
@@ -45,6 +46,10 @@ pub const AA_SPP: [u32; 2] = [4, 16];
 
 /// GI rows: these bounce counts, each at a ladder of samples per pixel.
 pub const GI_BOUNCES: [u32; 4] = [1, 2, 4, 8];
+
+/// Stage 6 rows, raw and denoised: these samples per pixel (paths end by roulette, at most
+/// [`GI_MAX_BOUNCES`] bounces).
+pub const DENOISE_SPP: [u32; 3] = [1, 4, 16];
 
 /// The most runs a fast row gets.
 pub const MAX_RUNS: u32 = 51;
@@ -125,6 +130,12 @@ pub enum RowKind {
         /// Samples per pixel.
         spp: u32,
     },
+    /// Stage 6 (path-traced, at most [`GI_MAX_BOUNCES`] bounces) with the denoiser; the time
+    /// includes the filter.
+    Denoised {
+        /// Samples per pixel.
+        spp: u32,
+    },
 }
 
 impl RowKind {
@@ -135,6 +146,7 @@ impl RowKind {
             RowKind::Stage(s) => s.name().into(),
             RowKind::Aa { .. } => "AA (seed, N = 0.5)".into(),
             RowKind::Gi { .. } => "GI".into(),
+            RowKind::Denoised { .. } => "GI + denoiser".into(),
         }
     }
 
@@ -142,12 +154,21 @@ impl RowKind {
     pub fn spp(&self) -> u32 {
         match *self {
             RowKind::Stage(_) => 1,
-            RowKind::Aa { spp } | RowKind::Gi { spp, .. } => spp,
+            RowKind::Aa { spp } | RowKind::Gi { spp, .. } | RowKind::Denoised { spp } => spp,
         }
     }
 
-    /// Maximum bounces (GI rows only).
+    /// Maximum bounces (GI rows, raw and denoised).
     pub fn bounces(&self) -> Option<u32> {
+        match *self {
+            RowKind::Gi { bounces, .. } => Some(bounces),
+            RowKind::Denoised { .. } => Some(GI_MAX_BOUNCES),
+            _ => None,
+        }
+    }
+
+    /// Maximum bounces of a raw GI row (`None` for every other row, denoised ones included).
+    pub fn raw_bounces(&self) -> Option<u32> {
         match *self {
             RowKind::Gi { bounces, .. } => Some(bounces),
             _ => None,
@@ -172,6 +193,11 @@ impl RowKind {
                 },
                 frame: 0,
             },
+            RowKind::Denoised { spp } => RowKind::Gi {
+                bounces: GI_MAX_BOUNCES,
+                spp,
+            }
+            .settings(scene),
         }
     }
 
@@ -234,7 +260,8 @@ pub struct BenchReport {
     pub environment: Environment,
 }
 
-/// The rows of one size: the seed's stages, anti-aliasing, then GI by bounces and samples.
+/// The rows of one size: the seed's stages, anti-aliasing, GI by bounces and samples, then
+/// stage 6 raw and denoised.
 pub fn rows_for(options: &BenchOptions) -> Vec<RowKind> {
     let mut rows: Vec<RowKind> = SEED_STAGES.iter().map(|&s| RowKind::Stage(s)).collect();
     rows.extend(AA_SPP.iter().map(|&spp| RowKind::Aa { spp }));
@@ -243,6 +270,14 @@ pub fn rows_for(options: &BenchOptions) -> Vec<RowKind> {
             rows.push(RowKind::Gi { bounces, spp });
         }
     }
+    let stage6 = DENOISE_SPP
+        .iter()
+        .filter(|&&spp| spp <= options.max_spp.max(1));
+    rows.extend(stage6.clone().map(|&spp| RowKind::Gi {
+        bounces: GI_MAX_BOUNCES,
+        spp,
+    }));
+    rows.extend(stage6.map(|&spp| RowKind::Denoised { spp }));
     rows
 }
 
@@ -308,8 +343,10 @@ fn measure(
     tick: impl FnMut(),
 ) -> Row {
     let settings = kind.settings(scene);
+    let denoised = matches!(kind, RowKind::Denoised { .. });
     let render_once = || {
-        render(
+        let draw = if denoised { render_denoised } else { render };
+        draw(
             scene,
             &scene.camera(),
             scene.lights(),
@@ -433,9 +470,17 @@ mod tests {
     fn rows_cover_the_stages_aa_and_every_bounce_count() {
         let o = BenchOptions::quick();
         let rows = rows_for(&o);
-        assert_eq!(rows.len(), 5 + 2 + 4 * o.spp_ladder().len());
+        assert_eq!(rows.len(), 5 + 2 + 4 * o.spp_ladder().len() + 2 * 2);
         assert_eq!(rows[4], RowKind::Stage(Stage::Indirect));
         assert_eq!(rows[6], RowKind::Aa { spp: 16 });
-        assert_eq!(rows.last(), Some(&RowKind::Gi { bounces: 8, spp: 4 }));
+        assert_eq!(rows[6 + 4 * 2], RowKind::Gi { bounces: 8, spp: 4 });
+        assert_eq!(
+            rows[6 + 4 * 2 + 1],
+            RowKind::Gi {
+                bounces: GI_MAX_BOUNCES,
+                spp: 1
+            }
+        );
+        assert_eq!(rows.last(), Some(&RowKind::Denoised { spp: 4 }));
     }
 }

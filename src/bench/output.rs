@@ -57,6 +57,39 @@ pub fn markdown(report: &BenchReport, command: &str) -> String {
     for info in &report.references {
         let _ = writeln!(s, "- {}", info.describe());
     }
+    for (w, h) in sizes(report) {
+        let denoised: Vec<&Row> = report
+            .rows
+            .iter()
+            .filter(|r| (r.width, r.height) == (w, h) && matches!(r.kind, RowKind::Denoised { .. }))
+            .collect();
+        if denoised.is_empty() {
+            continue;
+        }
+        let each: Vec<String> = denoised
+            .iter()
+            .map(|r| {
+                format!(
+                    "{} spp {:.1} ms RMSE {:.4}",
+                    r.kind.spp(),
+                    r.median_ms,
+                    r.rmse
+                )
+            })
+            .collect();
+        let goal = denoised
+            .iter()
+            .find(|r| r.median_ms <= GOAL_MS && r.rmse <= GOAL_RMSE)
+            .map_or("not met".to_string(), |r| {
+                format!("met at {} spp", r.kind.spp())
+            });
+        let _ = writeln!(
+            s,
+            "- GI + denoiser at {w}x{h}: {}; the goal of a frame in ≤ {GOAL_MS} ms at RMSE ≤ \
+             {GOAL_RMSE}: {goal}",
+            each.join(", ")
+        );
+    }
     for seed in report
         .rows
         .iter()
@@ -78,7 +111,7 @@ pub fn markdown(report: &BenchReport, command: &str) -> String {
                     .iter()
                     .filter(|r| {
                         (r.width, r.height) == (seed.width, seed.height)
-                            && r.kind.bounces() == Some(b)
+                            && r.kind.raw_bounces() == Some(b)
                     })
                     .max_by_key(|r| r.kind.spp())
             })
@@ -103,6 +136,22 @@ pub fn markdown(report: &BenchReport, command: &str) -> String {
         );
     }
     s
+}
+
+/// Stage 6's goal for a frame while keys are held (issue 12): this long at most…
+pub const GOAL_MS: f64 = 33.0;
+/// …at this RMSE at most.
+pub const GOAL_RMSE: f64 = 0.03;
+
+/// The sizes of a report's rows, in order of appearance.
+pub fn sizes(report: &BenchReport) -> Vec<(u32, u32)> {
+    let mut sizes: Vec<(u32, u32)> = Vec::new();
+    for r in &report.rows {
+        if !sizes.contains(&(r.width, r.height)) {
+            sizes.push((r.width, r.height));
+        }
+    }
+    sizes
 }
 
 /// The table's cells of one row.
@@ -201,6 +250,9 @@ const COLOURS: [&str; 6] = [
     "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b",
 ];
 
+/// The denoised series' colour, apart from the raw ones'.
+const DENOISED_COLOUR: &str = "#e6007e";
+
 const PANEL_W: f64 = 520.0;
 const PANEL_H: f64 = 400.0;
 /// Vertical distance between two labels' baselines, in pixels (the font is 11 px).
@@ -212,12 +264,7 @@ const MARGIN: (f64, f64, f64, f64) = (64.0, 150.0, 36.0, 44.0);
 /// The error against time, on log axes: one panel per size, one polyline per GI bounce count
 /// (its points are the spp ladder), the seed's stages and anti-aliasing as labelled points.
 pub fn svg(report: &BenchReport) -> String {
-    let mut sizes: Vec<(u32, u32)> = Vec::new();
-    for r in &report.rows {
-        if !sizes.contains(&(r.width, r.height)) {
-            sizes.push((r.width, r.height));
-        }
-    }
+    let sizes = sizes(report);
     let width = PANEL_W * sizes.len().max(1) as f64;
     let mut s = String::new();
     let _ = writeln!(
@@ -310,27 +357,31 @@ fn panel(s: &mut String, x0: f64, w: u32, h: u32, rows: &[&Row]) {
         (py0 + py1) / 2.0
     );
 
-    // One polyline per bounce count.
-    let mut bounces: Vec<u32> = rows.iter().filter_map(|r| r.kind.bounces()).collect();
-    bounces.dedup();
-    for (i, b) in bounces.iter().enumerate() {
-        let colour = COLOURS[i % COLOURS.len()];
-        let pts: Vec<String> = rows
+    // One polyline per series: raw GI by bounce count, then GI + denoiser.
+    let series = series(rows);
+    for (i, (name, class, members)) in series.iter().enumerate() {
+        let colour = if *class == "denoised" {
+            DENOISED_COLOUR
+        } else {
+            COLOURS[i % COLOURS.len()]
+        };
+        let pts: Vec<String> = members
             .iter()
-            .filter(|r| r.kind.bounces() == Some(*b))
             .map(|r| format!("{:.1},{:.1}", x(r.median_ms), y(r.rmse)))
             .collect();
+        let bounces = members.first().and_then(|r| r.kind.bounces()).unwrap_or(0);
         let _ = writeln!(
             s,
-            r#"<polyline class="gi" data-bounces="{b}" points="{}" fill="none" stroke="{colour}" stroke-width="1.5"/>"#,
+            r#"<polyline class="{class}" data-bounces="{bounces}" points="{}" fill="none" stroke="{colour}" stroke-width="1.5"/>"#,
             pts.join(" ")
         );
-        for r in rows.iter().filter(|r| r.kind.bounces() == Some(*b)) {
+        for r in members {
             let _ = writeln!(
                 s,
-                r#"<circle cx="{:.1}" cy="{:.1}" r="2.5" fill="{colour}"><title>GI {b} bounces, {} spp: {:.1} ms, RMSE {:.4}</title></circle>"#,
+                r#"<circle cx="{:.1}" cy="{:.1}" r="2.5" fill="{colour}"><title>{}, {} spp: {:.1} ms, RMSE {:.4}</title></circle>"#,
                 x(r.median_ms),
                 y(r.rmse),
+                escape(name),
                 r.kind.spp(),
                 r.median_ms,
                 r.rmse
@@ -339,12 +390,12 @@ fn panel(s: &mut String, x0: f64, w: u32, h: u32, rows: &[&Row]) {
         let ly = py0 + 14.0 + 16.0 * i as f64;
         let _ = writeln!(
             s,
-            r#"<line x1="{:.1}" y1="{ly:.1}" x2="{:.1}" y2="{ly:.1}" stroke="{colour}" stroke-width="2"/><text x="{:.1}" y="{:.1}">GI, {b} bounce{}</text>"#,
+            r#"<line x1="{:.1}" y1="{ly:.1}" x2="{:.1}" y2="{ly:.1}" stroke="{colour}" stroke-width="2"/><text x="{:.1}" y="{:.1}">{}</text>"#,
             px1 + 10.0,
             px1 + 30.0,
             px1 + 34.0,
             ly + 4.0,
-            if *b == 1 { "" } else { "s" }
+            escape(name)
         );
     }
     // The seed's stages and anti-aliasing: labelled points. Labels that would overlap (points
@@ -355,7 +406,7 @@ fn panel(s: &mut String, x0: f64, w: u32, h: u32, rows: &[&Row]) {
             let label = match r.kind {
                 RowKind::Aa { spp } => format!("AA {spp} spp"),
                 RowKind::Stage(st) => st.name().to_string(),
-                RowKind::Gi { .. } => return None,
+                RowKind::Gi { .. } | RowKind::Denoised { .. } => return None,
             };
             Some((x(r.median_ms), y(r.rmse), label))
         })
@@ -385,7 +436,7 @@ fn panel(s: &mut String, x0: f64, w: u32, h: u32, rows: &[&Row]) {
             escape(&label)
         );
     }
-    let ly = py0 + 14.0 + 16.0 * bounces.len() as f64;
+    let ly = py0 + 14.0 + 16.0 * series.len() as f64;
     let _ = writeln!(
         s,
         r##"<rect x="{:.1}" y="{:.1}" width="5" height="5" fill="#222"/><text x="{:.1}" y="{:.1}">seed stages, AA</text>"##,
@@ -394,6 +445,37 @@ fn panel(s: &mut String, x0: f64, w: u32, h: u32, rows: &[&Row]) {
         px1 + 34.0,
         ly + 4.0
     );
+}
+
+/// The plotted series of one size's rows, in order: raw GI by bounce count (its points are
+/// the spp ladder), then GI + denoiser. Each is (legend, SVG class, rows).
+pub fn series<'a>(rows: &[&'a Row]) -> Vec<(String, &'static str, Vec<&'a Row>)> {
+    let mut out: Vec<(String, &'static str, Vec<&'a Row>)> = Vec::new();
+    let mut bounces: Vec<u32> = rows.iter().filter_map(|r| r.kind.raw_bounces()).collect();
+    bounces.sort_unstable();
+    bounces.dedup();
+    for b in bounces {
+        let members = rows
+            .iter()
+            .filter(|r| r.kind.raw_bounces() == Some(b))
+            .copied()
+            .collect();
+        let name = if b == crate::shading::GI_MAX_BOUNCES {
+            format!("GI, roulette, ≤ {b} bounces")
+        } else {
+            format!("GI, {b} bounce{}", if b == 1 { "" } else { "s" })
+        };
+        out.push((name, "gi", members));
+    }
+    let denoised: Vec<&Row> = rows
+        .iter()
+        .filter(|r| matches!(r.kind, RowKind::Denoised { .. }))
+        .copied()
+        .collect();
+    if !denoised.is_empty() {
+        out.push(("GI + denoiser".into(), "denoised", denoised));
+    }
+    out
 }
 
 /// A decade's label: 10^k written out for small k, else as 1e±k.

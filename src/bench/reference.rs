@@ -100,6 +100,9 @@ pub struct ReferenceInfo {
     pub render_time: Duration,
     /// Samples per pixel taken over from a partial or smaller cached reference (0 if none).
     pub resumed_spp: u32,
+    /// Cache files that were refused (corrupt, truncated, another size) and removed, each
+    /// as a sentence saying which and why; what they held was rendered again.
+    pub refused: Vec<String>,
 }
 
 impl ReferenceInfo {
@@ -168,18 +171,31 @@ pub fn load_or_render(
     progress: &mut dyn Progress,
 ) -> io::Result<(Image, ReferenceInfo)> {
     let path = dir.join(spec.file_name());
-    let info = |cached, render_time, resumed_spp| ReferenceInfo {
-        spec: spec.clone(),
-        path: path.clone(),
-        cached,
-        render_time,
-        resumed_spp,
+    let mut refused = Vec::new();
+    let cached = |file: &Path, what: &str, refused: &mut Vec<String>| match read_cached(
+        file,
+        spec.width,
+        spec.height,
+    ) {
+        Ok(img) => img,
+        Err(why) => {
+            refused.push(format!(
+                "{what} {} was refused and removed ({why}); rendering it again",
+                home_relative(file)
+            ));
+            None
+        }
     };
-    if let Ok(bytes) = fs::read(&path)
-        && let Some(img) = read_pfm(&bytes)
-        && (img.width, img.height) == (spec.width, spec.height)
-    {
-        return Ok((img, info(true, Duration::ZERO, 0)));
+    if let Some(img) = cached(&path, "the cached reference", &mut refused) {
+        let info = ReferenceInfo {
+            spec: spec.clone(),
+            path,
+            cached: true,
+            render_time: Duration::ZERO,
+            resumed_spp: 0,
+            refused,
+        };
+        return Ok((img, info));
     }
     fs::create_dir_all(dir)?;
     let partial = path.with_extension("partial.pfm");
@@ -199,19 +215,33 @@ pub fn load_or_render(
             }
         }
     };
-    if let (Ok(bytes), Ok(count)) = (fs::read(&partial), fs::read_to_string(&partial_count))
-        && let (Some(img), Ok(n)) = (read_pfm(&bytes), count.trim().parse::<u32>())
-    {
-        start_from(img, n);
+    if let Some(img) = cached(&partial, "the partial reference", &mut refused) {
+        match fs::read_to_string(&partial_count)
+            .ok()
+            .and_then(|c| c.trim().parse::<u32>().ok())
+        {
+            Some(n) => start_from(img, n),
+            None => {
+                let _ = fs::remove_file(&partial);
+                refused.push(format!(
+                    "the partial reference {} was removed (its pass count {} is missing or \
+                     unreadable); rendering it again",
+                    home_relative(&partial),
+                    home_relative(&partial_count)
+                ));
+            }
+        }
     }
     for fewer in (1..passes).rev() {
         let prefix = ReferenceSpec {
             spp: fewer * PASS_SPP,
             ..spec.clone()
         };
-        if let Ok(bytes) = fs::read(dir.join(prefix.file_name()))
-            && let Some(img) = read_pfm(&bytes)
-        {
+        if let Some(img) = cached(
+            &dir.join(prefix.file_name()),
+            "the cached reference",
+            &mut refused,
+        ) {
             start_from(img, fewer);
             break;
         }
@@ -251,7 +281,51 @@ pub fn load_or_render(
     write_atomically(&path, &pfm_bytes(&mean)?)?;
     let _ = fs::remove_file(&partial);
     let _ = fs::remove_file(&partial_count);
-    Ok((mean, info(false, start.elapsed(), resumed * PASS_SPP)))
+    let info = ReferenceInfo {
+        spec: spec.clone(),
+        path,
+        cached: false,
+        render_time: start.elapsed(),
+        resumed_spp: resumed * PASS_SPP,
+        refused,
+    };
+    Ok((mean, info))
+}
+
+/// The `width`×`height` image cached at `path`: `Ok(None)` if there is no such file, `Err` with
+/// the reason if there is one but it is not such an image (another format, corrupt, truncated,
+/// another size); that file is then removed, so it is refused once, not on every run. A file
+/// larger than the image needs is refused without being read.
+fn read_cached(path: &Path, width: u32, height: u32) -> Result<Option<Image>, String> {
+    let refuse = |why: String| {
+        let _ = fs::remove_file(path);
+        Err(why)
+    };
+    let mut file = match fs::File::open(path) {
+        Ok(f) => f,
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(format!("it cannot be read: {e}")),
+    };
+    // The header ("PF\n", two numbers of at most 10 digits, "-1.0\n") takes under 64 bytes.
+    let most = (u64::from(width) * u64::from(height))
+        .saturating_mul(12)
+        .saturating_add(64);
+    let len = file.metadata().map_err(|e| e.to_string())?.len();
+    if len > most {
+        return refuse(format!(
+            "it is {len} bytes, more than a {width}x{height} image takes"
+        ));
+    }
+    let mut bytes = Vec::with_capacity(len as usize);
+    io::Read::read_to_end(&mut file, &mut bytes).map_err(|e| format!("it cannot be read: {e}"))?;
+    match Image::read_pfm(&bytes) {
+        Ok(img) if (img.width, img.height) == (width, height) => Ok(Some(img)),
+        Ok(img) => refuse(format!(
+            "it is {}x{}, not {width}x{height}",
+            img.width, img.height
+        )),
+        Err(e) => refuse(e.to_string()),
+    }
 }
 
 fn pfm_bytes(img: &Image) -> io::Result<Vec<u8>> {
@@ -268,59 +342,10 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     fs::rename(&tmp, path)
 }
 
-/// Reads a colour PFM (`PF`, little-endian as [`Image::write_pfm`] writes it, bottom row first).
-/// `None` if it is anything else or truncated.
-pub fn read_pfm(bytes: &[u8]) -> Option<Image> {
-    // Three whitespace-terminated header tokens after "PF": width, height, scale.
-    let mut pos = 0;
-    let mut token = || {
-        while bytes.get(pos)?.is_ascii_whitespace() {
-            pos += 1;
-        }
-        let start = pos;
-        while !bytes.get(pos)?.is_ascii_whitespace() {
-            pos += 1;
-        }
-        let t = std::str::from_utf8(&bytes[start..pos]).ok()?;
-        pos += 1; // the single whitespace byte that ends the token
-        Some(t.to_string())
-    };
-    if token()? != "PF" {
-        return None;
-    }
-    let width: u32 = token()?.parse().ok()?;
-    let height: u32 = token()?.parse().ok()?;
-    let scale: f32 = token()?.parse().ok()?;
-    if !(scale < 0.0) {
-        return None; // big-endian files are not ours
-    }
-    let n = width as usize * height as usize;
-    let data = bytes.get(pos..pos + n * 12)?;
-    let mut img = Image::new(width, height);
-    for (i, px) in data.chunks_exact(12).enumerate() {
-        let f = |k: usize| f32::from_le_bytes([px[k], px[k + 1], px[k + 2], px[k + 3]]);
-        let (x, row) = (i % width as usize, i / width as usize);
-        let y = height as usize - 1 - row;
-        img.pixels[y * width as usize + x] = Vec3::new(f(0), f(4), f(8));
-    }
-    Some(img)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::bench::NoProgress;
-
-    #[test]
-    fn pfm_round_trips() {
-        let mut img = Image::new(3, 2);
-        for (i, p) in img.pixels.iter_mut().enumerate() {
-            *p = Vec3::new(i as f32, 0.5 * i as f32, -1.25);
-        }
-        assert_eq!(read_pfm(&pfm_bytes(&img).unwrap()), Some(img));
-        assert_eq!(read_pfm(b"P6\n1 1\n255\n..."), None);
-        assert_eq!(read_pfm(b"PF\n2 2\n-1.0\n"), None);
-    }
 
     /// A reference that starts from a cached one with fewer samples equals one rendered whole
     /// (up to the rounding of mean·n), and a second call reads it from the cache.
@@ -341,6 +366,39 @@ mod tests {
         assert!(info.cached && info.describe().contains("read from the cache"));
         assert_eq!(again, resumed);
         let _ = fs::remove_dir_all(&tmp);
+    }
+
+    /// A corrupt cache file (here a header whose size overflows, which used to be read with
+    /// an unchecked `width·height·12`) is refused with a message, removed, and rendered again.
+    #[test]
+    fn a_corrupt_cache_file_is_refused_and_rendered_again() {
+        let scene = crate::scene::cornell::cornell_box();
+        let dir = std::env::temp_dir().join(format!("raytty-ref-corrupt-{}", std::process::id()));
+        let spec = ReferenceSpec::new(&scene, 12, 10, 16, 4);
+        let (good, _) = load_or_render(&scene, &spec, &dir, &mut NoProgress).unwrap();
+        let path = dir.join(spec.file_name());
+        for corrupt in [
+            &b"PF\n4294967295 4294967295\n-1.0\n\0\0\0\0"[..],
+            b"PF\n12 10\n-1.0\ntruncated",
+            b"PF\n3 2\n-1.0\n",
+            &[0u8; 2000],
+        ] {
+            fs::write(&path, corrupt).unwrap();
+            let (img, info) = load_or_render(&scene, &spec, &dir, &mut NoProgress).unwrap();
+            assert_eq!(img, good);
+            assert!(!info.cached);
+            assert_eq!(info.refused.len(), 1, "{:?}", info.refused);
+            let note = &info.refused[0];
+            assert!(
+                note.contains(&spec.file_name()) && note.contains("refused"),
+                "{note}"
+            );
+            // Rewritten whole: the next call reads it back and refuses nothing.
+            let (again, info) = load_or_render(&scene, &spec, &dir, &mut NoProgress).unwrap();
+            assert!(info.cached && info.refused.is_empty());
+            assert_eq!(again, good);
+        }
+        let _ = fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -203,6 +203,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
             }),
             stage: Stage::Indirect,
             samples: None,
+            denoise: Switch::On,
             camera: None,
             light: None,
             output: None,

@@ -6,6 +6,7 @@ use std::io::{self, BufWriter, IsTerminal, Write};
 use anyhow::Context;
 use clap::ValueEnum;
 use glam::Vec3;
+use raytty::denoise::render_denoised;
 use raytty::{CellGrid, ColorMode, PointLight, Scene, encode_text, render};
 
 use raytty::image::MAX_PIXELS;
@@ -70,6 +71,12 @@ pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool)
     if let Some(n) = args.samples {
         settings.effects.samples = n;
     }
+    if args.output.is_none() && stdout_was_closed() {
+        return Err(anyhow::anyhow!(
+            "stdout is closed: there is nowhere to write the frame (redirect it, or give -o FILE)"
+        )
+        .into());
+    }
     // The output file is created before the (maybe long) render, so a bad path fails at once.
     let mut out: Box<dyn Write> = match &args.output {
         Some(path) => Box::new(BufWriter::new(
@@ -77,7 +84,11 @@ pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool)
         )),
         None => Box::new(BufWriter::new(io::stdout().lock())),
     };
-    let frame = render(&scene, &camera, &lights, &settings, w, h);
+    let frame = if args.denoise == Switch::On {
+        render_denoised(&scene, &camera, &lights, &settings, w, h)
+    } else {
+        render(&scene, &camera, &lights, &settings, w, h)
+    };
     let written = match format {
         Format::Png => frame.image.write_png(&mut out),
         Format::Pfm => frame.image.write_pfm(&mut out),
@@ -106,6 +117,45 @@ pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool)
         None => {}
     }
     Ok(())
+}
+
+/// Whether stdout was closed when raytty started (`raytty render >&-`), as opposed to a pipe
+/// whose reader went away later (a broken pipe, which is not an error). Rust's runtime replaces
+/// a closed standard descriptor with /dev/null before `main` (so that no file opened later
+/// takes its number), after which writes to it succeed and vanish; so this is read earlier,
+/// from an ELF constructor, while fd 1 is still as the shell left it. Elsewhere than on Linux,
+/// false.
+pub(super) fn stdout_was_closed() -> bool {
+    #[cfg(target_os = "linux")]
+    return stdout_at_start::CLOSED.load(std::sync::atomic::Ordering::Relaxed);
+    #[cfg(not(target_os = "linux"))]
+    false
+}
+
+#[cfg(target_os = "linux")]
+mod stdout_at_start {
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    /// Set before `main` when fd 1 was not open.
+    pub(super) static CLOSED: AtomicBool = AtomicBool::new(false);
+
+    unsafe extern "C" {
+        fn fcntl(fd: i32, cmd: i32, ...) -> i32;
+    }
+    /// `fcntl`'s "get descriptor flags": fails (EBADF) only if the descriptor is not open.
+    const F_GETFD: i32 = 1;
+
+    extern "C" fn record() {
+        // SAFETY: F_GETFD reads a descriptor's flags and changes nothing; it takes no pointer.
+        if unsafe { fcntl(1, F_GETFD) } == -1 {
+            CLOSED.store(true, Ordering::Relaxed);
+        }
+    }
+
+    /// Run by the loader before `main`, as the standard library's own argument capture is.
+    #[used]
+    #[unsafe(link_section = ".init_array")]
+    static RECORD: extern "C" fn() = record;
 }
 
 /// `message` without the " (os error N)" that Rust's I/O errors end with: the words before it

@@ -43,10 +43,13 @@ impl Aabb {
         (self.min + self.max) * 0.5
     }
 
-    /// Robust slab test (pbrt-v4): does the ray meet the box for some `t` in `[0, t_max)`?
-    /// The far distance is widened by 2γ₃ so rounding never culls a box the ray grazes.
-    #[inline]
-    pub fn hit(&self, ray: &Ray, t_max: f32) -> bool {
+    /// The slab test, the one every box test in the crate is held to bit for bit (the BVH's
+    /// paired SSE2 and portable forms, in `accel::bvh`'s tests): where `ray` enters the box
+    /// within `[0, t_max]`, or `None` if it misses it there. The far side of each slab is
+    /// widened by pbrt-v4's 1 + 2γ₃ so that rounding never culls a box the ray grazes; a NaN
+    /// slab distance (a ray parallel to a slab whose origin lies on its plane) leaves the
+    /// interval unchanged.
+    pub fn enter(&self, ray: &Ray, t_max: f32) -> Option<f32> {
         let mut t0 = 0.0f32;
         let mut t1 = t_max;
         for i in 0..3 {
@@ -57,7 +60,6 @@ impl Aabb {
                 std::mem::swap(&mut near, &mut far);
             }
             far *= 1.0 + 2.0 * gamma(3);
-            // NaN (origin on a slab plane of a parallel ray) leaves the interval unchanged.
             if near > t0 {
                 t0 = near;
             }
@@ -65,9 +67,15 @@ impl Aabb {
                 t1 = far;
             }
             if t0 > t1 {
-                return false;
+                return None;
             }
         }
-        true
+        Some(t0)
+    }
+
+    /// Whether `ray` meets the box within `[0, t_max]` ([`Aabb::enter`]).
+    #[inline]
+    pub fn hit(&self, ray: &Ray, t_max: f32) -> bool {
+        self.enter(ray, t_max).is_some()
     }
 }

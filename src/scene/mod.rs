@@ -361,6 +361,11 @@ impl Scene {
         self.accel.stats()
     }
 
+    /// The object (in the order added) that triangle `triangle` belongs to.
+    pub fn object_of(&self, triangle: u32) -> u32 {
+        self.objects.partition_point(|r| r.end <= triangle as usize) as u32
+    }
+
     /// Whether any material reflects specularly (if not, no reflection ray is ever traced).
     pub fn has_mirrors(&self) -> bool {
         self.has_mirrors

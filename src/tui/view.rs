@@ -5,6 +5,7 @@
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
+use raytty::bench::timing::ms;
 use raytty::{CellGrid, FrameStats, HitCache, Image, Stage, encode_diff, printable, render_cached};
 
 use super::app::App;
@@ -258,10 +259,6 @@ fn fixed(v: f32, decimals: usize) -> String {
 
 fn xyz(v: Vec3) -> String {
     format!("{},{},{}", fixed(v.x, 2), fixed(v.y, 2), fixed(v.z, 2))
-}
-
-fn ms(d: Duration) -> f64 {
-    d.as_secs_f64() * 1e3
 }
 
 #[cfg(test)]

@@ -1,0 +1,554 @@
+//! Frame diffs: the bytes that bring a terminal showing one grid to showing another, exactly or
+//! within a tolerance, optionally within a byte budget. Cheaper than a cell-by-cell repaint:
+//! - unchanged cells are skipped, with the shortest cursor move (`CUF`, `CR LF`, `CUP`, ...);
+//! - a short unchanged run is rewritten instead when that costs fewer bytes than the move;
+//! - a block cell is drawn whichever way the pen's colours carry over best: `▀` (upper pixel
+//!   as foreground) or `▄` (lower pixel as foreground), and a cell of one colour as a space
+//!   (background) or `█` (foreground);
+//! - one SGR sets the foreground and the background together, and only what changes.
+
+use super::{Cell, CellGrid, Colour, Pen, UPPER_HALF, WIDE_TAIL, write_char};
+
+/// The lower-half block: its foreground paints the cell's lower pixel.
+pub const LOWER_HALF: char = '▄';
+/// The full block: its foreground paints both pixels.
+pub const FULL_BLOCK: char = '█';
+
+/// Within a row, the next cell sent is the cheapest (cursor move, SGR, character) of the next
+/// this many cells to send: a few bytes of cursor move buy a cell whose colours the pen holds.
+const ORDER_WINDOW: usize = 16;
+
+/// How far a cell on screen may be from the frame's: a cell is sent if any channel of either
+/// of its pixels differs by more than `tolerance` levels (0: exact), or if it differs in any
+/// way that is not a colour level (a character, a palette colour).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DiffLimits {
+    /// Largest per-channel difference left unsent (truecolor block cells only).
+    pub tolerance: u8,
+    /// Stop starting new cells once this many bytes are written (`usize::MAX`: no limit).
+    pub max_bytes: usize,
+    /// The row to begin with (rows are visited in order from it, wrapping around), so that
+    /// frames cut short by the budget take turns over the screen.
+    pub first_row: usize,
+}
+
+impl DiffLimits {
+    /// Every difference, no budget.
+    pub const EXACT: DiffLimits = DiffLimits {
+        tolerance: 0,
+        max_bytes: usize::MAX,
+        first_row: 0,
+    };
+}
+
+/// What a diff left undone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DiffOutcome {
+    /// Every cell beyond the tolerance was sent (the budget did not cut the frame short).
+    pub complete: bool,
+    /// Where the next frame should begin if this one was cut short.
+    pub next_row: usize,
+    /// The largest difference left on screen: 0 when the screen shows the frame exactly,
+    /// [`UNLIKE`] when some cell differs in more than its colour levels.
+    pub max_error: u16,
+}
+
+/// The distance between two cells that differ in more than colour levels.
+pub const UNLIKE: u16 = 256;
+
+/// The two pixels a block cell shows (`▀`, or a space with a background), if it is one.
+pub fn pixels(cell: &Cell) -> Option<(Colour, Colour)> {
+    match (cell.ch, cell.fg, cell.bg) {
+        (UPPER_HALF, Some(f), Some(b)) => Some((f, b)),
+        (' ', _, Some(b)) => Some((b, b)),
+        _ => None,
+    }
+}
+
+/// How far apart two cells look: 0 if alike, the largest channel difference of the two
+/// pixels of truecolor block cells, else [`UNLIKE`].
+pub fn distance(a: &Cell, b: &Cell) -> u16 {
+    match (pixels(a), pixels(b)) {
+        (Some(pa), Some(pb)) => {
+            if pa == pb {
+                return 0;
+            }
+            let d = |x: Colour, y: Colour| match (x, y) {
+                (Colour::Rgb(r0, g0, b0), Colour::Rgb(r1, g1, b1)) => {
+                    [r0.abs_diff(r1), g0.abs_diff(g1), b0.abs_diff(b1)]
+                        .into_iter()
+                        .max()
+                        .map_or(0, u16::from)
+                }
+                _ if x == y => 0,
+                _ => UNLIKE,
+            };
+            d(pa.0, pb.0).max(d(pa.1, pb.1))
+        }
+        _ if a == b => 0,
+        _ => UNLIKE,
+    }
+}
+
+/// The bytes that turn a screen showing `prev` (or, if `None`, anything) into one showing
+/// `next` exactly, with the grid's top-left at the screen's row `top` (0-based); the pen is
+/// reset at the end. A `prev` of another size counts as `None`.
+pub fn encode_diff(prev: Option<&CellGrid>, next: &CellGrid, top: usize, out: &mut Vec<u8>) {
+    let mut shown = prev.cloned();
+    encode_diff_within(&mut shown, next, top, DiffLimits::EXACT, out);
+}
+
+/// Like [`encode_diff`], within `limits`, updating `shown` (what the screen shows; `None` or
+/// another size: unknown, so every cell is sent) to what it shows afterwards. Cells within the
+/// tolerance are left as they are; a cell that is sent is sent exactly.
+pub fn encode_diff_within(
+    shown: &mut Option<CellGrid>,
+    next: &CellGrid,
+    top: usize,
+    limits: DiffLimits,
+    out: &mut Vec<u8>,
+) -> DiffOutcome {
+    if shown
+        .as_ref()
+        .is_none_or(|s| s.cols != next.cols || s.rows != next.rows)
+    {
+        // Unknown: every cell is sent, against a screen taken to show nothing alike.
+        *shown = Some(CellGrid {
+            cols: next.cols,
+            rows: next.rows,
+            cells: vec![
+                Cell {
+                    ch: WIDE_TAIL,
+                    fg: None,
+                    bg: None,
+                };
+                next.cells.len()
+            ],
+        });
+    }
+    let Some(screen) = shown.as_mut() else {
+        unreachable!("set above");
+    };
+    let start = out.len();
+    let mut w = Writer {
+        pen: Pen::default(),
+        cursor: None,
+        top,
+    };
+    let mut outcome = DiffOutcome {
+        complete: true,
+        next_row: 0,
+        max_error: 0,
+    };
+    let cols = next.cols;
+    'rows: for k in 0..next.rows {
+        let r = (limits.first_row + k) % next.rows.max(1);
+        let row = r * cols..(r + 1) * cols;
+        let want = &next.cells[row.clone()];
+        let have = &mut screen.cells[row];
+        let dirty = |have: &[Cell], c: usize| -> bool {
+            if want[c].ch == WIDE_TAIL {
+                return false;
+            }
+            let tail = c + 1 < cols && want[c + 1].ch == WIDE_TAIL;
+            distance(&have[c], &want[c]) > limits.tolerance as u16
+                || (tail && have[c + 1] != want[c + 1])
+        };
+        let mut todo: Vec<usize> = (0..cols).filter(|&c| dirty(have, c)).collect();
+        while !todo.is_empty() {
+            if out.len() - start >= limits.max_bytes {
+                outcome = DiffOutcome {
+                    complete: false,
+                    next_row: r,
+                    max_error: UNLIKE,
+                };
+                break 'rows;
+            }
+            // Of the next few cells of the row to send, the cheapest to reach and draw.
+            let pick = (0..todo.len().min(ORDER_WINDOW))
+                .min_by_key(|&k| w.move_len(r, todo[k]) + w.draw_cost(&want[todo[k]]))
+                .unwrap_or(0);
+            let c = todo.remove(pick);
+            w.move_to(out, r, c);
+            w.draw(out, &want[c], todo.first().map(|&n| &want[n]));
+            have[c] = want[c];
+            let wide = c + 1 < cols && want[c + 1].ch == WIDE_TAIL;
+            if wide {
+                have[c + 1] = want[c + 1];
+            }
+            // Past the last column the cursor position is terminal-dependent: forget it. So is
+            // it after a wide character, should the terminal's width tables differ from ours.
+            w.cursor = (c + 1 < cols && !wide).then_some((r, c + 1));
+        }
+    }
+    if outcome.complete {
+        outcome.max_error = screen
+            .cells
+            .iter()
+            .zip(&next.cells)
+            .map(|(a, b)| distance(a, b))
+            .max()
+            .unwrap_or(0);
+    }
+    if out.len() > start && (w.pen.fg.is_some() || w.pen.bg.is_some()) {
+        out.extend_from_slice(b"\x1b[0m");
+    }
+    outcome
+}
+
+/// The encoder's belief about the terminal: the pen and, if known, the cursor.
+#[derive(Clone, Copy)]
+struct Writer {
+    pen: Pen,
+    cursor: Option<(usize, usize)>,
+    top: usize,
+}
+
+/// One way to draw a cell: the character, and the colours it needs (`None`: any).
+type Way = (char, Option<Colour>, Option<Colour>);
+
+/// The ways to draw `cell` that look the same: two for a block cell, one for text.
+fn ways(cell: &Cell) -> [Way; 2] {
+    match pixels(cell) {
+        Some((u, l)) if u == l => [(' ', None, Some(u)), (FULL_BLOCK, Some(u), None)],
+        Some((u, l)) => [
+            (UPPER_HALF, Some(u), Some(l)),
+            (LOWER_HALF, Some(l), Some(u)),
+        ],
+        None => [(cell.ch, cell.fg, cell.bg); 2],
+    }
+}
+
+/// Bytes of the decimal form of `v`.
+fn digits(v: u8) -> usize {
+    match v {
+        0..=9 => 1,
+        10..=99 => 2,
+        _ => 3,
+    }
+}
+
+/// Bytes of `38;2;R;G;B` (or `38;5;N`) for `c`.
+fn colour_len(c: Colour) -> usize {
+    match c {
+        Colour::Rgb(r, g, b) => 7 + digits(r) + digits(g) + digits(b),
+        Colour::Indexed(i) => 5 + digits(i),
+    }
+}
+
+/// Bytes of the SGR that gives `pen` the colours of `way`, and the pen afterwards.
+fn sgr_cost(pen: Pen, way: &Way) -> (usize, Pen) {
+    let fg = way.1.filter(|&c| Some(c) != pen.fg);
+    let bg = way.2.filter(|&c| Some(c) != pen.bg);
+    let len = match (fg, bg) {
+        (None, None) => 0,
+        (Some(a), None) | (None, Some(a)) => 3 + colour_len(a),
+        (Some(a), Some(b)) => 4 + colour_len(a) + colour_len(b),
+    };
+    let after = Pen {
+        fg: way.1.or(pen.fg),
+        bg: way.2.or(pen.bg),
+    };
+    (len + way.0.len_utf8(), after)
+}
+
+impl Writer {
+    /// Draws `cell` at the cursor the cheapest way, counting what the pen it leaves costs the
+    /// cell drawn `after` it, if any.
+    fn draw(&mut self, out: &mut Vec<u8>, cell: &Cell, after: Option<&Cell>) {
+        let best = ways(cell)
+            .into_iter()
+            .min_by_key(|way| {
+                let (cost, pen) = sgr_cost(self.pen, way);
+                let next = after.map_or(0, |n| {
+                    ways(n)
+                        .iter()
+                        .map(|w| sgr_cost(pen, w).0)
+                        .min()
+                        .unwrap_or(0)
+                });
+                cost + next
+            })
+            .unwrap_or((cell.ch, cell.fg, cell.bg));
+        self.pen.set(
+            out,
+            &Cell {
+                ch: best.0,
+                fg: best.1,
+                bg: best.2,
+            },
+        );
+        write_char(out, best.0);
+        if let Some((r, c)) = self.cursor {
+            self.cursor = Some((r, c + 1));
+        }
+    }
+
+    /// Bytes of the cheapest way to draw `cell` with the pen as it is.
+    fn draw_cost(&self, cell: &Cell) -> usize {
+        ways(cell)
+            .iter()
+            .map(|w| sgr_cost(self.pen, w).0)
+            .min()
+            .unwrap_or(0)
+    }
+
+    /// Bytes of [`Writer::move_to`] (row, col).
+    fn move_len(&self, r: usize, c: usize) -> usize {
+        match self.cursor {
+            Some((cr, cc)) if cr == r => match cc.abs_diff(c) {
+                0 => 0,
+                1 => 3,
+                n => 3 + n.to_string().len(),
+            },
+            _ => {
+                let mut scratch = Vec::new();
+                let mut w = *self;
+                w.move_to(&mut scratch, r, c);
+                scratch.len()
+            }
+        }
+    }
+
+    /// Moves the cursor to (row, col) of the grid the shortest way it knows.
+    fn move_to(&mut self, out: &mut Vec<u8>, r: usize, c: usize) {
+        let mut best = format!("\x1b[{};{}H", self.top + r + 1, c + 1);
+        let mut consider = |s: String| {
+            if s.len() < best.len() {
+                best = s;
+            }
+        };
+        let horizontal = |from: usize, to: usize| match to.cmp(&from) {
+            std::cmp::Ordering::Equal => String::new(),
+            std::cmp::Ordering::Greater => relative(to - from, 'C'),
+            std::cmp::Ordering::Less => relative(from - to, 'D'),
+        };
+        match self.cursor {
+            Some((cr, cc)) if cr == r => consider(horizontal(cc, c)),
+            Some((cr, cc)) if cr < r => {
+                let down = r - cr;
+                consider(format!("\r{}{}", "\n".repeat(down), horizontal(0, c)));
+                consider(format!("{}{}", relative(down, 'B'), horizontal(cc, c)));
+            }
+            _ => {}
+        }
+        out.extend_from_slice(best.as_bytes());
+        self.cursor = Some((r, c));
+    }
+}
+
+/// A relative cursor move by `n` (CUF `C`, CUB `D`, CUD `B`), with the default count left out.
+fn relative(n: usize, f: char) -> String {
+    if n == 1 {
+        format!("\x1b[{f}")
+    } else {
+        format!("\x1b[{n}{f}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::half_block;
+
+    /// What a cell shows: its two pixels for a block-drawing cell, else its character and
+    /// colours (the foreground of a space is invisible).
+    #[derive(Debug, PartialEq)]
+    enum Look {
+        Pixels(Option<Colour>, Option<Colour>),
+        Text(char, Option<Colour>, Option<Colour>),
+    }
+
+    fn look(cell: &Cell) -> Look {
+        match cell.ch {
+            UPPER_HALF => Look::Pixels(cell.fg, cell.bg),
+            LOWER_HALF => Look::Pixels(cell.bg, cell.fg),
+            FULL_BLOCK => Look::Pixels(cell.fg, cell.fg),
+            ' ' => Look::Pixels(cell.bg, cell.bg),
+            ch => Look::Text(ch, cell.fg, cell.bg),
+        }
+    }
+
+    fn looks(g: &CellGrid) -> Vec<Look> {
+        g.cells.iter().map(look).collect()
+    }
+
+    /// A small terminal: applies cursor moves, SGR colours and characters to `screen`, as the
+    /// encoders use them; panics on anything else.
+    fn apply(screen: &mut CellGrid, bytes: &[u8]) {
+        let text = std::str::from_utf8(bytes).expect("UTF-8 output");
+        let (mut r, mut c) = (0usize, 0usize);
+        let (mut fg, mut bg) = (None, None);
+        let mut chars = text.chars().peekable();
+        while let Some(ch) = chars.next() {
+            match ch {
+                '\r' => c = 0,
+                '\n' => r += 1,
+                '\x1b' => {}
+                _ => {
+                    screen.cells[r * screen.cols + c] = Cell { ch, fg, bg };
+                    c += 1;
+                }
+            }
+            if ch != '\x1b' {
+                continue;
+            }
+            assert_eq!(chars.next(), Some('['));
+            let mut params = String::new();
+            let fin = loop {
+                let ch = chars.next().expect("a whole sequence");
+                if ch.is_ascii_alphabetic() {
+                    break ch;
+                }
+                params.push(ch);
+            };
+            let nums: Vec<usize> = params.split(';').map(|p| p.parse().unwrap_or(0)).collect();
+            // A relative move's count defaults to 1.
+            let n = nums[0].max(1);
+            match fin {
+                'H' => (r, c) = (nums[0] - 1, nums[1] - 1),
+                'C' => c += n,
+                'D' => c -= n,
+                'B' => r += n,
+                'm' => {
+                    let mut i = 0;
+                    while i < nums.len() {
+                        let target = match nums[i] {
+                            0 => {
+                                (fg, bg) = (None, None);
+                                i += 1;
+                                continue;
+                            }
+                            38 => &mut fg,
+                            48 => &mut bg,
+                            n => panic!("SGR {n}"),
+                        };
+                        if nums[i + 1] == 2 {
+                            let v = |k: usize| nums[i + k] as u8;
+                            *target = Some(Colour::Rgb(v(2), v(3), v(4)));
+                            i += 5;
+                        } else {
+                            *target = Some(Colour::Indexed(nums[i + 2] as u8));
+                            i += 3;
+                        }
+                    }
+                }
+                f => panic!("unexpected sequence ending in {f}"),
+            }
+        }
+    }
+
+    fn grid(cells: Vec<Cell>, cols: usize) -> CellGrid {
+        CellGrid {
+            cols,
+            rows: cells.len() / cols,
+            cells,
+        }
+    }
+
+    fn block(up: Colour, lo: Colour) -> Cell {
+        half_block(up, lo)
+    }
+
+    /// `encode_diff(prev → next)` applied to a screen showing `prev` shows `next`; returns the
+    /// bytes.
+    fn round_trip(prev: &CellGrid, next: &CellGrid) -> Vec<u8> {
+        let mut out = Vec::new();
+        encode_diff(Some(prev), next, 0, &mut out);
+        let mut screen = prev.clone();
+        apply(&mut screen, &out);
+        assert_eq!(
+            looks(&screen),
+            looks(next),
+            "{:?}",
+            String::from_utf8_lossy(&out)
+        );
+        out
+    }
+
+    #[test]
+    fn a_change_of_only_the_background_foreground_or_character_is_sent() {
+        let (a, b, c) = (
+            Colour::Rgb(10, 20, 30),
+            Colour::Rgb(200, 100, 0),
+            Colour::Rgb(7, 7, 7),
+        );
+        let prev = grid(vec![block(a, b), block(b, a), block(a, c)], 3);
+        let only_bg = grid(vec![block(a, b), block(b, c), block(a, c)], 3);
+        let only_fg = grid(vec![block(a, b), block(c, a), block(a, c)], 3);
+        let mut only_ch = prev.clone();
+        only_ch.cells[1].ch = 'x';
+        for next in [&only_bg, &only_fg, &only_ch] {
+            let out = round_trip(&prev, next);
+            assert!(!out.is_empty());
+            // One cell changed: the first and last are not rewritten.
+            let mut screen = prev.clone();
+            screen.cells[0].ch = '?';
+            screen.cells[2].ch = '?';
+            apply(&mut screen, &out);
+            assert_eq!((screen.cells[0].ch, screen.cells[2].ch), ('?', '?'));
+        }
+    }
+
+    #[test]
+    fn seeded_random_diffs_bring_any_screen_to_the_next_frame() {
+        struct XorShift(u64);
+        impl XorShift {
+            fn below(&mut self, n: u64) -> u64 {
+                self.0 ^= self.0 << 13;
+                self.0 ^= self.0 >> 7;
+                self.0 ^= self.0 << 17;
+                self.0 % n
+            }
+        }
+        // A few colours, so runs, equal pixels and carried-over pens all happen.
+        let palette = [
+            Colour::Rgb(0, 0, 0),
+            Colour::Rgb(255, 255, 255),
+            Colour::Rgb(1, 2, 3),
+            Colour::Indexed(16),
+        ];
+        let cell = |rng: &mut XorShift| match rng.below(8) {
+            0 => Cell {
+                ch: (b'a' + rng.below(3) as u8) as char,
+                fg: Some(palette[rng.below(4) as usize]),
+                bg: Some(palette[rng.below(4) as usize]),
+            },
+            _ => block(
+                palette[rng.below(4) as usize],
+                palette[rng.below(4) as usize],
+            ),
+        };
+        let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
+        for case in 0..500 {
+            let cols = 1 + rng.below(12) as usize;
+            let rows = 1 + rng.below(4) as usize;
+            let prev = grid((0..cols * rows).map(|_| cell(&mut rng)).collect(), cols);
+            let mut next = prev.clone();
+            for _ in 0..rng.below(2 * (cols * rows) as u64) {
+                let i = rng.below((cols * rows) as u64) as usize;
+                next.cells[i] = cell(&mut rng);
+            }
+            let out = round_trip(&prev, &next);
+            assert_eq!(out.is_empty(), looks(&prev) == looks(&next), "case {case}");
+            let mut any = grid(vec![block(palette[0], palette[0]); cols * rows], cols);
+            let mut full = Vec::new();
+            encode_diff(None, &next, 0, &mut full);
+            apply(&mut any, &full);
+            assert_eq!(looks(&any), looks(&next), "case {case}");
+        }
+    }
+
+    #[test]
+    fn diff_of_identical_frames_is_empty() {
+        let g = grid(
+            vec![block(Colour::Rgb(76, 51, 25), Colour::Rgb(229, 229, 229))],
+            1,
+        );
+        let mut out = Vec::new();
+        encode_diff(Some(&g), &g, 0, &mut out);
+        assert!(out.is_empty());
+        encode_diff(None, &g, 0, &mut out);
+        assert!(out.starts_with(b"\x1b[1;1H"));
+    }
+}
