@@ -17,6 +17,7 @@
 pub mod accel;
 pub mod bench;
 pub mod camera;
+pub mod denoise;
 pub mod frame;
 pub mod geometry;
 pub mod image;
@@ -30,7 +31,7 @@ pub use camera::Camera;
 pub use frame::{CellGrid, ColorMode, encode_diff, encode_text, printable};
 pub use geometry::{Ray, Triangle};
 pub use image::Image;
-pub use render::{Frame, FrameStats, HitCache, render, render_cached};
+pub use render::{Frame, FrameStats, HitCache, render, render_cached, render_guided};
 pub use scene::cornell::cornell_box;
 pub use scene::{Effects, Indirect, Material, PointLight, Scene, SceneBuilder};
 pub use shading::{Mode, RayCounts, Settings, Stage, Tracer};

@@ -11,6 +11,7 @@ use rayon::prelude::*;
 
 use crate::accel::Hit;
 use crate::camera::Camera;
+use crate::denoise::{GuidePixel, Guides};
 use crate::image::Image;
 use crate::rng::Rng;
 use crate::scene::{PointLight, Scene};
@@ -34,6 +35,9 @@ pub struct Frame {
     pub image: Image,
     /// What it cost.
     pub stats: FrameStats,
+    /// The denoiser's guide buffers: only from [`render_guided`] with path-traced indirect
+    /// light.
+    pub guides: Option<Guides>,
 }
 
 /// The primary hits of the last frame, reused while the camera, size and geometry stay the
@@ -98,12 +102,70 @@ pub fn render_cached(
     height: u32,
     cache: &mut HitCache,
 ) -> Frame {
+    render_impl(scene, camera, lights, settings, width, height, cache, false)
+}
+
+/// [`render_cached`], and with path-traced indirect light the denoiser's guide buffers too
+/// ([`Frame::guides`]). The image is the same as [`render_cached`]'s.
+pub fn render_guided(
+    scene: &Scene,
+    camera: &Camera,
+    lights: &[PointLight],
+    settings: &Settings,
+    width: u32,
+    height: u32,
+    cache: &mut HitCache,
+) -> Frame {
+    render_impl(scene, camera, lights, settings, width, height, cache, true)
+}
+
+/// One sample through `ray`. A path-traced frame's sample is split (the same colour either
+/// way, but one way of computing it, so that guided and plain frames agree bit for bit), and
+/// its parts are added to `guide` when the frame keeps guides.
+#[inline]
+fn sample(
+    tracer: &Tracer,
+    ray: &crate::geometry::Ray,
+    hit: Option<Hit>,
+    rng: &mut Rng,
+    n: &mut RayCounts,
+    guide: Option<&mut GuidePixel>,
+) -> Vec3 {
+    if !tracer.splits() {
+        return tracer.shade_primary(ray, hit, rng, n);
+    }
+    let s = tracer.sample_primary(ray, hit, rng, n);
+    if let Some(g) = guide {
+        g.add(&s);
+    }
+    s.colour()
+}
+
+#[allow(clippy::too_many_arguments)]
+fn render_impl(
+    scene: &Scene,
+    camera: &Camera,
+    lights: &[PointLight],
+    settings: &Settings,
+    width: u32,
+    height: u32,
+    cache: &mut HitCache,
+    guided: bool,
+) -> Frame {
     let start = Instant::now();
     let samples = settings.effects.samples.max(1);
     let tracer = Tracer::new(scene, lights, *settings);
     let rays = camera.rays(width, height);
     let (w, h) = (width as usize, height as usize);
     let mut image = Image::new(width, height);
+    // Path-traced frames split every sample for the denoiser (same colour, in any case).
+    let split = tracer.splits();
+    let mut guides = (guided && split).then(|| Guides {
+        width,
+        height,
+        samples,
+        pixels: vec![GuidePixel::default(); w * h],
+    });
     if w == 0 || h == 0 {
         return Frame {
             image,
@@ -111,8 +173,14 @@ pub fn render_cached(
                 samples,
                 ..FrameStats::default()
             },
+            guides,
         };
     }
+    // Rows of guide pixels, or none: zipped with the image's rows, `None` rows for none.
+    let mut guide_rows: Vec<Option<&mut [GuidePixel]>> = match guides.as_mut() {
+        Some(g) => g.pixels.chunks_mut(w).map(Some).collect(),
+        None => (0..h).map(|_| None).collect(),
+    };
 
     let key = Some((camera_key(camera), width, height));
     let counts = if samples == 1 {
@@ -124,8 +192,9 @@ pub fn render_cached(
             .pixels
             .par_chunks_mut(w)
             .zip(cache.hits.par_chunks_mut(w))
+            .zip(guide_rows.par_iter_mut())
             .enumerate()
-            .map(|(y, (row, hits))| {
+            .map(|(y, ((row, hits), guide_row))| {
                 let mut n = RayCounts::default();
                 for (x, (px, hit)) in row.iter_mut().zip(hits.iter_mut()).enumerate() {
                     let ray = rays.ray(x as f32 + 0.5, y as f32 + 0.5);
@@ -134,7 +203,8 @@ pub fn render_cached(
                         *hit = scene.intersect(&ray, f32::INFINITY);
                     }
                     let mut rng = Rng::for_sample((y * w + x) as u64, 0, settings.frame);
-                    *px = tracer.shade_primary(&ray, *hit, &mut rng, &mut n);
+                    let g = guide_row.as_mut().map(|r| &mut r[x]);
+                    *px = sample(&tracer, &ray, *hit, &mut rng, &mut n, g);
                 }
                 n
             })
@@ -147,8 +217,9 @@ pub fn render_cached(
         image
             .pixels
             .par_chunks_mut(w)
+            .zip(guide_rows.par_iter_mut())
             .enumerate()
-            .map(|(y, row)| {
+            .map(|(y, (row, guide_row))| {
                 let mut n = RayCounts::default();
                 for (x, px) in row.iter_mut().enumerate() {
                     let mut acc = Vec3::ZERO;
@@ -167,9 +238,13 @@ pub fn render_cached(
                         let ray = rays.ray(x as f32 + ox, y as f32 + oy);
                         n.primary += 1;
                         let hit = scene.intersect(&ray, f32::INFINITY);
-                        acc += tracer.shade_primary(&ray, hit, &mut rng, &mut n);
+                        let g = guide_row.as_mut().map(|r| &mut r[x]);
+                        acc += sample(&tracer, &ray, hit, &mut rng, &mut n, g);
                     }
                     *px = acc / samples as f32;
+                    if let Some(r) = guide_row.as_mut() {
+                        r[x].scale(1.0 / samples as f32);
+                    }
                 }
                 n
             })
@@ -182,10 +257,58 @@ pub fn render_cached(
             samples,
             elapsed: start.elapsed(),
         },
+        guides,
     }
 }
 
 fn sum(mut a: RayCounts, b: RayCounts) -> RayCounts {
     a += b;
     a
+}
+
+impl FrameStats {
+    /// Millions of rays (all kinds) per second of the render's wall-clock time.
+    pub fn mrays_per_s(&self) -> f64 {
+        let s = self.elapsed.as_secs_f64();
+        if s > 0.0 {
+            self.rays.total() as f64 / s / 1e6
+        } else {
+            0.0
+        }
+    }
+
+    /// One line for people: time, samples, rays by kind, M rays/s and the SIMD path.
+    pub fn summary(&self, isa: crate::accel::Isa) -> String {
+        let r = &self.rays;
+        format!(
+            "{:.2} ms, {} spp, rays: {} primary, {} shadow, {} bounce, {} reflection; {:.2} M rays/s ({}, {} threads)",
+            self.elapsed.as_secs_f64() * 1e3,
+            self.samples,
+            r.primary,
+            r.shadow,
+            r.bounce,
+            r.reflection,
+            self.mrays_per_s(),
+            isa.name(),
+            rayon::current_num_threads()
+        )
+    }
+
+    /// The same as one JSON object: `ms`, `spp`, `rays` (by kind), `mrays_per_s`, and the
+    /// `simd` path and `threads`.
+    pub fn to_json(&self, isa: crate::accel::Isa) -> String {
+        let r = &self.rays;
+        format!(
+            "{{\"ms\":{:.3},\"spp\":{},\"rays\":{{\"primary\":{},\"shadow\":{},\"bounce\":{},\"reflection\":{}}},\"mrays_per_s\":{:.3},\"simd\":\"{}\",\"threads\":{}}}",
+            self.elapsed.as_secs_f64() * 1e3,
+            self.samples,
+            r.primary,
+            r.shadow,
+            r.bounce,
+            r.reflection,
+            self.mrays_per_s(),
+            isa.name(),
+            rayon::current_num_threads()
+        )
+    }
 }

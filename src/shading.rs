@@ -79,7 +79,9 @@ impl Stage {
                 Mode::Colour,
                 Effects {
                     shadows: true,
-                    indirect: Indirect::PathTraced { bounces: 4 },
+                    indirect: Indirect::PathTraced {
+                        bounces: GI_MAX_BOUNCES,
+                    },
                     samples: 1,
                 },
             ),
@@ -143,6 +145,46 @@ impl std::ops::AddAssign for RayCounts {
     }
 }
 
+/// One sample of a pixel split for the denoiser: its colour is `rest + albedo·irradiance`.
+/// `irradiance` is the noisy path-traced indirect irradiance at the pixel's guide vertex,
+/// demodulated (not yet multiplied by any reflectance); everything else, above all the exact
+/// direct light and its hard shadows, is in `rest`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SplitSample {
+    /// What the denoiser leaves alone.
+    pub rest: Vec3,
+    /// The weight of `irradiance` in the pixel: the guide vertex's reflectance, times the
+    /// mirror reflectances on the way there.
+    pub albedo: Vec3,
+    /// Indirect irradiance at the guide vertex (one path-traced estimate).
+    pub irradiance: Vec3,
+    /// The guide vertex, `None` for a ray that hit nothing.
+    pub guide: Option<GuideHit>,
+}
+
+impl SplitSample {
+    /// The sample's colour, as [`Tracer::shade_primary`] would give it.
+    #[inline]
+    pub fn colour(&self) -> Vec3 {
+        self.rest + self.albedo * self.irradiance
+    }
+}
+
+/// The surface a pixel's indirect light is filtered on: the primary hit, or for a mirror
+/// whose reflection outweighs its own diffuse part, the reflected hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GuideHit {
+    /// The hit point.
+    pub position: Vec3,
+    /// The unit normal on the side the ray came from.
+    pub normal: Vec3,
+    /// The object hit (the order objects were added to the scene).
+    pub object: u32,
+    /// Mirror reflections before the hit (0 for the primary hit): a reflected floor is not the
+    /// floor next to it.
+    pub reflections: u32,
+}
+
 /// A shadow ray stops this fraction of its length short of the light, so that a light lying
 /// exactly on a surface is not shadowed by that surface's own rounding. Relative, so it holds at
 /// every scale.
@@ -156,6 +198,12 @@ pub const MAX_MIRROR_DEPTH: u32 = 8;
 /// box, so ending it early adds little noise and saves the rays of the long tail (measured in
 /// the README's "What accuracy costs").
 pub const ROULETTE_START: u32 = 3;
+
+/// Stage 6's bounce cap: a safety net, not a model. Paths end by Russian roulette; one that
+/// survived 16 bounces in the Cornell box (albedo ≤ 0.75, an open front) carries under 0.75¹⁶ ≈
+/// 1 % of its weight, and reaching it takes a run of survivals that almost never happens. It is
+/// also the bench reference's bounce count, so stage 6 converges to the reference itself.
+pub const GI_MAX_BOUNCES: u32 = 16;
 
 /// Roulette never gives a path less than this chance to survive, so that the `1/q` weight of a
 /// survivor (and the noise it brings) stays bounded on very dark surfaces.
@@ -193,6 +241,107 @@ impl<'a> Tracer<'a> {
         let c = self.shade(ray, &hit, 0, 0, rng, n);
         debug_assert!(c.is_finite(), "non-finite colour {c}");
         c
+    }
+
+    /// Whether this frame's indirect light is path traced, so that [`Tracer::sample_primary`]
+    /// has something to split.
+    pub fn splits(&self) -> bool {
+        self.settings.mode == Mode::Colour
+            && matches!(self.settings.effects.indirect, Indirect::PathTraced { .. })
+    }
+
+    /// One sample along a primary ray, split for the denoiser (see [`SplitSample`]). Its
+    /// colour equals [`Tracer::shade_primary`]'s in value; the random numbers are drawn in the
+    /// same order.
+    pub fn sample_primary(
+        &self,
+        ray: &Ray,
+        hit: Option<Hit>,
+        rng: &mut Rng,
+        n: &mut RayCounts,
+    ) -> SplitSample {
+        let Some(hit) = hit else {
+            return SplitSample::default();
+        };
+        let s = self.split(ray, &hit, 0, rng, n);
+        debug_assert!(s.colour().is_finite(), "non-finite colour {}", s.colour());
+        s
+    }
+
+    fn split(
+        &self,
+        ray: &Ray,
+        hit: &Hit,
+        mirror_depth: u32,
+        rng: &mut Rng,
+        n: &mut RayCounts,
+    ) -> SplitSample {
+        let tri = &self.scene.triangles()[hit.triangle as usize];
+        let material = &self.scene.materials()[tri.material as usize];
+        if self.settings.mode != Mode::Colour {
+            return SplitSample {
+                rest: self.shade(ray, hit, mirror_depth, 0, rng, n),
+                ..SplitSample::default()
+            };
+        }
+        let (p, err) = hit_point(&tri.v, hit.b);
+        let normal = if tri.normal.dot(ray.dir) > 0.0 {
+            -tri.normal
+        } else {
+            tri.normal
+        };
+        let reflects = material.mirror > 0.0 && mirror_depth < MAX_MIRROR_DEPTH;
+        // As in `shade`: a perfect mirror's own shading and a black surface's cost no ray.
+        let (direct, irradiance) =
+            if (reflects && material.mirror >= 1.0) || material.colour == Vec3::ZERO {
+                (Vec3::ZERO, Vec3::ZERO)
+            } else {
+                (
+                    self.direct(p, err, normal, n),
+                    self.indirect(material, p, err, normal, mirror_depth, 0, rng, n),
+                )
+            };
+        let own = SplitSample {
+            rest: material.colour * direct,
+            albedo: material.colour,
+            irradiance,
+            guide: Some(GuideHit {
+                position: p,
+                normal,
+                object: self.scene.object_of(hit.triangle),
+                reflections: mirror_depth,
+            }),
+        };
+        if !reflects {
+            return own;
+        }
+        let m = material.mirror;
+        let d = ray.dir.normalize();
+        let dir = d - 2.0 * d.dot(normal) * normal;
+        let origin = offset_ray_origin(p, err, normal, dir);
+        n.reflection += 1;
+        let reflected_ray = Ray::new(origin, dir);
+        let reflected = match self.scene.intersect(&reflected_ray, f32::INFINITY) {
+            Some(h) => self.split(&reflected_ray, &h, mirror_depth + 1, rng, n),
+            None => SplitSample::default(),
+        };
+        // The pixel is filtered on whichever surface weighs more in it; the other one's
+        // indirect light stays in `rest`, unfiltered.
+        if reflected.guide.is_some()
+            && (reflected.albedo * m).max_element() > (own.albedo * (1.0 - m)).max_element()
+        {
+            SplitSample {
+                rest: own.colour() * (1.0 - m) + reflected.rest * m,
+                albedo: reflected.albedo * m,
+                ..reflected
+            }
+        } else {
+            SplitSample {
+                rest: own.rest * (1.0 - m) + reflected.colour() * m,
+                albedo: own.albedo * (1.0 - m),
+                ..own
+            }
+        }
     }
 
     /// The colour seen along `ray` (any depth).
@@ -334,7 +483,7 @@ impl<'a> Tracer<'a> {
 }
 
 /// A cosine-weighted direction on the hemisphere around `n` (unit length).
-fn cosine_sample(n: Vec3, rng: &mut Rng) -> Vec3 {
+pub(crate) fn cosine_sample(n: Vec3, rng: &mut Rng) -> Vec3 {
     let (u1, u2) = (rng.next_f32(), rng.next_f32());
     let r = u1.sqrt();
     let phi = 2.0 * PI * u2;

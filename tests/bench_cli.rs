@@ -37,9 +37,13 @@ fn text(b: &[u8]) -> String {
 }
 
 /// Rows per size: 5 seed stages, AA at 4 and 16 spp, GI at 4 bounce counts × the quick ladder
-/// (1 and 4 spp).
-const ROWS_PER_SIZE: usize = 5 + 2 + 4 * 2;
+/// (1 and 4 spp), then stage 6 raw and denoised at 1 and 4 spp.
+const ROWS_PER_SIZE: usize = 5 + 2 + 4 * 2 + 2 * 2;
 const SIZES: usize = 2;
+
+/// The throughput section's table: header, alignment, and one row per ray kind (the quick
+/// bench measures the Cornell box only).
+const THROUGHPUT_LINES: usize = 2 + 4;
 
 #[test]
 fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
@@ -47,8 +51,32 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
     let out = bench(&dir.0, &[]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
-    let table: Vec<&str> = stdout.lines().filter(|l| l.starts_with('|')).collect();
+    let (accuracy, throughput) = stdout
+        .split_once("Ray throughput")
+        .expect("a throughput section");
+    let table: Vec<&str> = accuracy.lines().filter(|l| l.starts_with('|')).collect();
     assert_eq!(table.len(), 2 + SIZES * ROWS_PER_SIZE, "{stdout}");
+    let rates: Vec<&str> = throughput.lines().filter(|l| l.starts_with('|')).collect();
+    assert_eq!(rates.len(), THROUGHPUT_LINES, "{stdout}");
+    for (row, kind) in rates[2..]
+        .iter()
+        .zip(["primary", "shadow", "bounce", "reflection"])
+    {
+        let cells: Vec<&str> = row.trim_matches('|').split('|').map(str::trim).collect();
+        assert_eq!(cells[0], "cornell", "{row}");
+        assert_eq!(cells[4], kind, "{row}");
+        for rate in &cells[6..] {
+            assert!(rate.parse::<f64>().is_ok_and(|r| r > 0.0), "{row}");
+        }
+    }
+    assert_eq!(
+        table
+            .iter()
+            .filter(|l| l.contains("| GI + denoiser |"))
+            .count(),
+        2 * SIZES
+    );
+    assert_eq!(stdout.matches("\n- GI + denoiser at ").count(), SIZES);
     let header: Vec<&str> = table[0]
         .trim_matches('|')
         .split('|')
@@ -217,9 +245,11 @@ fn the_svg_is_well_formed_with_one_polyline_per_bounce_count() {
     assert!(svg.starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\""));
     let names = elements(&svg);
     assert_eq!(names[0], "svg");
-    assert_eq!(names.iter().filter(|n| *n == "polyline").count(), 4 * SIZES);
-    for b in [1, 2, 4, 8] {
-        let tag = format!("data-bounces=\"{b}\" points=\"");
+    // Raw GI at 1, 2, 4, 8 and stage 6's roulette cap (16) bounces, and GI + denoiser.
+    assert_eq!(names.iter().filter(|n| *n == "polyline").count(), 6 * SIZES);
+    assert_eq!(svg.matches("polyline class=\"denoised\"").count(), SIZES);
+    for b in [1, 2, 4, 8, 16] {
+        let tag = format!("class=\"gi\" data-bounces=\"{b}\" points=\"");
         let lines: Vec<&str> = svg.lines().filter(|l| l.contains(&tag)).collect();
         assert_eq!(lines.len(), SIZES, "{b} bounces");
         for l in lines {
@@ -257,7 +287,7 @@ fn the_readme_changes_only_between_the_markers() {
     assert!(!inner.contains("old table"));
     assert_eq!(
         inner.lines().filter(|l| l.starts_with('|')).count(),
-        2 + SIZES * ROWS_PER_SIZE
+        2 + SIZES * ROWS_PER_SIZE + THROUGHPUT_LINES
     );
     // The table in the README is the one printed.
     assert_eq!(inner.trim(), text(&out.stdout).trim());

@@ -168,8 +168,8 @@ fn no_color_makes_the_default_text_format_ascii() {
     assert!(run(true, &["--format", "ansi"]).contains("\x1b[38;2;"));
 }
 
-/// The PFM `raytty render --stage gi --samples n` writes, as linear floats.
-fn gi_pixels(samples: &str) -> Vec<f32> {
+/// The PFM `raytty render --stage gi --samples n --denoise on|off` writes, as linear floats.
+fn gi_pixels_denoised(samples: &str, denoise: &str) -> Vec<f32> {
     let out = raytty(&[
         "render",
         "--stage",
@@ -180,6 +180,8 @@ fn gi_pixels(samples: &str) -> Vec<f32> {
         "pfm",
         "--samples",
         samples,
+        "--denoise",
+        denoise,
     ]);
     assert!(
         out.status.success(),
@@ -191,6 +193,48 @@ fn gi_pixels(samples: &str) -> Vec<f32> {
         .chunks_exact(4)
         .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
         .collect()
+}
+
+/// The raw estimate.
+fn gi_pixels(samples: &str) -> Vec<f32> {
+    gi_pixels_denoised(samples, "off")
+}
+
+#[test]
+fn the_denoiser_is_a_switch_that_brings_one_sample_closer() {
+    let reference = gi_pixels("256");
+    let error = |p: Vec<f32>| -> f32 {
+        p.iter()
+            .zip(&reference)
+            .map(|(a, b)| (a - b).abs())
+            .sum::<f32>()
+            / p.len() as f32
+    };
+    let (raw, denoised) = (
+        error(gi_pixels_denoised("1", "off")),
+        error(gi_pixels_denoised("1", "on")),
+    );
+    assert!(
+        denoised < raw / 2.0,
+        "denoised ({denoised}) is not much closer to 256 samples than raw ({raw})"
+    );
+    // The default is on; a stage without path tracing is the same either way.
+    let default = raytty(&["render", "--stage", "gi", "--size", "20x10"]);
+    let on = raytty(&[
+        "render",
+        "--stage",
+        "gi",
+        "--size",
+        "20x10",
+        "--denoise",
+        "on",
+    ]);
+    assert_eq!(default.stdout, on.stdout);
+    let seed = |d: &str| raytty(&["render", "--size", "20x10", "--denoise", d]).stdout;
+    assert_eq!(seed("on"), seed("off"));
+    let out = raytty(&["render", "--denoise", "maybe"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("on"));
 }
 
 #[test]
@@ -255,6 +299,16 @@ fn a_closed_stdout_is_an_error_and_a_closed_pipe_is_not() {
         assert_eq!(
             err,
             "raytty: stdout is closed: there is nowhere to write the frame (redirect it, or give -o FILE)\n"
+        );
+    }
+    // The list and the bench's table likewise.
+    for (args, what) in [("scenes", "the list"), ("bench --quick", "the table")] {
+        let out = with_stdout_closed(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args}: {err}");
+        assert_eq!(
+            err,
+            format!("raytty: stdout is closed: there is nowhere to write {what} (redirect it)\n")
         );
     }
     // With -o the frame does not go to stdout, so a closed one does not matter.

@@ -25,8 +25,14 @@ mod build;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::hit::{Hit, cull_bound, shrunk_t_max};
-use crate::geometry::{Ray, Triangle, gamma, intersect_watertight};
+use super::hit::{Hit, cull_bound};
+use super::isa::Isa;
+#[cfg(target_arch = "x86_64")]
+use super::tri4::{Avx2, Sse2};
+use super::tri4::{
+    Closest, Kernel, LANES, Portable, RayLanes, Tri4, blocks_closest, blocks_occluded,
+};
+use crate::geometry::{Ray, Triangle, gamma};
 
 pub use build::{LEAF_MAX, SAH_BINS};
 
@@ -198,9 +204,10 @@ pub struct Bvh {
     /// Sibling pairs in depth-first order; the root alone in the first. Node `i` is lane
     /// `i % 2` of pair `i / 2`.
     nodes: Vec<Pair>,
-    /// Vertices in leaf order.
-    vertices: Vec<[Vec3; 3]>,
-    /// Scene index of each entry of `vertices`.
+    /// Each leaf's triangles in [`Tri4`] blocks (the last one padded), leaves in depth-first
+    /// order; a leaf's [`Node::offset`] is its first block.
+    blocks: Vec<Tri4>,
+    /// Scene index of each lane of `blocks` (`u32::MAX` for padding).
     ids: Vec<u32>,
     depth: u32,
 }
@@ -214,15 +221,31 @@ impl Bvh {
             "a BVH holds at most 2³² − 1 triangles"
         );
         let built = build::build(triangles);
-        let vertices = built
-            .order
-            .par_iter()
-            .map(|&i| triangles[i as usize].v)
-            .collect();
+        let mut nodes: Vec<Pair> = built.pairs.into_par_iter().map(Pair::new).collect();
+        let leaves = |p: &Pair| (0..2).filter(|&l| p.count[l] > 0).count();
+        let n_blocks: usize = nodes
+            .iter()
+            .flat_map(|p| (0..2).map(|l| (p.count[l] as usize).div_ceil(LANES)))
+            .sum();
+        let mut blocks = Vec::with_capacity(n_blocks);
+        let mut ids = Vec::with_capacity(n_blocks * LANES);
+        for p in nodes.iter_mut().filter(|p| leaves(p) > 0) {
+            for lane in 0..2 {
+                let (offset, count) = (p.offset[lane] as usize, p.count[lane] as usize);
+                if count == 0 {
+                    continue;
+                }
+                let leaf = &built.order[offset..offset + count];
+                p.offset[lane] = u32::try_from(blocks.len()).expect("fewer than 2³² blocks");
+                blocks.extend(Tri4::pack(leaf.iter().map(|&i| triangles[i as usize].v)));
+                ids.extend_from_slice(leaf);
+                ids.resize(blocks.len() * LANES, u32::MAX);
+            }
+        }
         Bvh {
-            nodes: built.pairs.into_par_iter().map(Pair::new).collect(),
-            vertices,
-            ids: built.order,
+            nodes,
+            blocks,
+            ids,
             depth: built.depth,
         }
     }
@@ -275,14 +298,62 @@ impl Bvh {
         self.all_nodes().filter(|n| n.is_leaf()).count()
     }
 
-    /// The closest hit with `t < t_max` (ties go to the lowest scene index), or `None`.
+    /// The closest hit with `t < t_max` (ties go to the lowest scene index), or `None`, on
+    /// the widest SIMD path this CPU has.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        self.intersect_on(Isa::detect(), ray, t_max)
+    }
+
+    /// Whether some triangle has a hit with `t < t_max` (stops at the first found), on the
+    /// widest SIMD path this CPU has.
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        self.occluded_on(Isa::detect(), ray, t_max)
+    }
+
+    /// [`Bvh::intersect`] on path `isa`, which must be available.
+    pub fn intersect_on(&self, isa: Isa, ray: &Ray, t_max: f32) -> Option<Hit> {
+        assert!(isa.available(), "{} is not available", isa.name());
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: checked available above.
+            Isa::Avx2 => unsafe { closest_avx2(self, ray, t_max) },
+            #[cfg(target_arch = "x86_64")]
+            Isa::Sse2 => self.closest::<Sse2>(ray, t_max),
+            _ => self.closest::<Portable>(ray, t_max),
+        }
+    }
+
+    /// [`Bvh::occluded`] on path `isa`, which must be available.
+    pub fn occluded_on(&self, isa: Isa, ray: &Ray, t_max: f32) -> bool {
+        assert!(isa.available(), "{} is not available", isa.name());
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: checked available above.
+            Isa::Avx2 => unsafe { occluded_avx2(self, ray, t_max) },
+            #[cfg(target_arch = "x86_64")]
+            Isa::Sse2 => self.any::<Sse2>(ray, t_max),
+            _ => self.any::<Portable>(ray, t_max),
+        }
+    }
+
+    /// A leaf's blocks and their lanes' scene indices.
+    #[inline(always)]
+    fn leaf(&self, offset: usize, count: usize) -> (&[Tri4], &[u32]) {
+        let end = offset + count.div_ceil(LANES);
+        (
+            &self.blocks[offset..end],
+            &self.ids[offset * LANES..end * LANES],
+        )
+    }
+
+    #[inline(always)]
+    fn closest<K: Kernel>(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let root = self.nodes.first()?;
         let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
         let mut bound = cull_bound(t_max);
         root.enter(&o, &inv, bound)[0]?;
-        let mut best: Option<Hit> = None;
-        let mut tri_t_max = t_max;
+        let r = RayLanes::new(ray);
+        let mut c = Closest::new(t_max);
         let mut stack = [(0u32, 0f32); MAX_DEPTH];
         let mut sp = 0;
         let mut i = 0usize;
@@ -290,20 +361,10 @@ impl Bvh {
             let (pair, lane) = (&self.nodes[i >> 1], i & 1);
             let (offset, count) = (pair.offset[lane] as usize, pair.count[lane] as usize);
             if count > 0 {
-                for k in offset..offset + count {
-                    let Some(h) = intersect_watertight(ray, &self.vertices[k], tri_t_max) else {
-                        continue;
-                    };
-                    let id = self.ids[k];
-                    if best.is_none_or(|b| h.t < b.t || h.t == b.t && id < b.triangle) {
-                        best = Some(Hit {
-                            t: h.t,
-                            b: h.b,
-                            triangle: id,
-                        });
-                        tri_t_max = shrunk_t_max(h.t, t_max);
-                        bound = cull_bound(h.t);
-                    }
+                let (blocks, ids) = self.leaf(offset, count);
+                blocks_closest::<K>(blocks, ids, ray, &r, &mut c);
+                if let Some(h) = c.best {
+                    bound = cull_bound(h.t);
                 }
             } else {
                 let (a, b) = (offset, offset + 1);
@@ -331,7 +392,7 @@ impl Bvh {
             // Pop the next node the ray can still reach before the best hit.
             loop {
                 if sp == 0 {
-                    return best;
+                    return c.best;
                 }
                 sp -= 1;
                 let (n, t_enter) = stack[sp];
@@ -343,12 +404,13 @@ impl Bvh {
         }
     }
 
-    /// Whether some triangle has a hit with `t < t_max` (stops at the first found).
-    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+    #[inline(always)]
+    fn any<K: Kernel>(&self, ray: &Ray, t_max: f32) -> bool {
         let Some(root) = self.nodes.first() else {
             return false;
         };
         let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
+        let r = RayLanes::new(ray);
         let bound = cull_bound(t_max);
         if root.enter(&o, &inv, bound)[0].is_none() {
             return false;
@@ -360,10 +422,7 @@ impl Bvh {
             let (pair, lane) = (&self.nodes[i >> 1], i & 1);
             let (offset, count) = (pair.offset[lane] as usize, pair.count[lane] as usize);
             if count > 0 {
-                if self.vertices[offset..offset + count]
-                    .iter()
-                    .any(|v| intersect_watertight(ray, v, t_max).is_some())
-                {
+                if blocks_occluded::<K>(self.leaf(offset, count).0, ray, &r, t_max) {
                     return true;
                 }
             } else {
@@ -392,9 +451,22 @@ impl Bvh {
     }
 }
 
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn closest_avx2(bvh: &Bvh, ray: &Ray, t_max: f32) -> Option<Hit> {
+    bvh.closest::<Avx2>(ray, t_max)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn occluded_avx2(bvh: &Bvh, ray: &Ray, t_max: f32) -> bool {
+    bvh.any::<Avx2>(ray, t_max)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::accel::shrunk_t_max;
     use crate::geometry::Aabb;
 
     #[test]

@@ -6,28 +6,34 @@
 //! Markdown table, CSV, an SVG plot, the README block). The binary only parses the flags.
 
 pub mod command;
+mod environment;
 pub mod metrics;
 pub mod output;
 pub mod progress;
 pub mod reference;
 pub mod scene;
+pub mod svg;
 pub mod table;
+pub mod throughput;
 pub mod timing;
 
 use std::io;
 use std::path::PathBuf;
-use std::time::{Duration, SystemTime, UNIX_EPOCH};
+use std::time::Duration;
 
+use crate::denoise::render_denoised;
 use crate::frame::{CellGrid, ColorMode, encode_text};
 use crate::image::Image;
 use crate::render::render;
 use crate::scene::{Effects, Indirect, Scene};
-use crate::shading::{Mode, RayCounts, Settings, Stage};
+use crate::shading::{GI_MAX_BOUNCES, Mode, RayCounts, Settings, Stage};
 
 pub use command::{BenchError, BenchRequest, check_sizes, run_command};
-pub use output::{csv, markdown, rewrite_readme, svg};
+use environment::{load_average, machine, utc_now};
+pub use output::{csv, markdown, rewrite_readme};
 pub use progress::{NoProgress, Progress};
 pub use reference::{ReferenceInfo, ReferenceSpec};
+pub use svg::svg;
 use timing::{Runs, ms};
 
 /// The seed's stages that get a row each (stage 6, GI, has its own rows).
@@ -44,6 +50,10 @@ pub const AA_SPP: [u32; 2] = [4, 16];
 
 /// GI rows: these bounce counts, each at a ladder of samples per pixel.
 pub const GI_BOUNCES: [u32; 4] = [1, 2, 4, 8];
+
+/// Stage 6 rows, raw and denoised: these samples per pixel (paths end by roulette, at most
+/// [`GI_MAX_BOUNCES`] bounces).
+pub const DENOISE_SPP: [u32; 3] = [1, 4, 16];
 
 /// The most runs a fast row gets.
 pub const MAX_RUNS: u32 = 51;
@@ -124,6 +134,12 @@ pub enum RowKind {
         /// Samples per pixel.
         spp: u32,
     },
+    /// Stage 6 (path-traced, at most [`GI_MAX_BOUNCES`] bounces) with the denoiser; the time
+    /// includes the filter.
+    Denoised {
+        /// Samples per pixel.
+        spp: u32,
+    },
 }
 
 impl RowKind {
@@ -134,6 +150,7 @@ impl RowKind {
             RowKind::Stage(s) => s.name().into(),
             RowKind::Aa { .. } => "AA (seed, N = 0.5)".into(),
             RowKind::Gi { .. } => "GI".into(),
+            RowKind::Denoised { .. } => "GI + denoiser".into(),
         }
     }
 
@@ -141,12 +158,21 @@ impl RowKind {
     pub fn spp(&self) -> u32 {
         match *self {
             RowKind::Stage(_) => 1,
-            RowKind::Aa { spp } | RowKind::Gi { spp, .. } => spp,
+            RowKind::Aa { spp } | RowKind::Gi { spp, .. } | RowKind::Denoised { spp } => spp,
         }
     }
 
-    /// Maximum bounces (GI rows only).
+    /// Maximum bounces (GI rows, raw and denoised).
     pub fn bounces(&self) -> Option<u32> {
+        match *self {
+            RowKind::Gi { bounces, .. } => Some(bounces),
+            RowKind::Denoised { .. } => Some(GI_MAX_BOUNCES),
+            _ => None,
+        }
+    }
+
+    /// Maximum bounces of a raw GI row (`None` for every other row, denoised ones included).
+    pub fn raw_bounces(&self) -> Option<u32> {
         match *self {
             RowKind::Gi { bounces, .. } => Some(bounces),
             _ => None,
@@ -171,6 +197,11 @@ impl RowKind {
                 },
                 frame: 0,
             },
+            RowKind::Denoised { spp } => RowKind::Gi {
+                bounces: GI_MAX_BOUNCES,
+                spp,
+            }
+            .settings(scene),
         }
     }
 
@@ -233,7 +264,8 @@ pub struct BenchReport {
     pub environment: Environment,
 }
 
-/// The rows of one size: the seed's stages, anti-aliasing, then GI by bounces and samples.
+/// The rows of one size: the seed's stages, anti-aliasing, GI by bounces and samples, then
+/// stage 6 raw and denoised.
 pub fn rows_for(options: &BenchOptions) -> Vec<RowKind> {
     let mut rows: Vec<RowKind> = SEED_STAGES.iter().map(|&s| RowKind::Stage(s)).collect();
     rows.extend(AA_SPP.iter().map(|&spp| RowKind::Aa { spp }));
@@ -242,6 +274,14 @@ pub fn rows_for(options: &BenchOptions) -> Vec<RowKind> {
             rows.push(RowKind::Gi { bounces, spp });
         }
     }
+    let stage6 = DENOISE_SPP
+        .iter()
+        .filter(|&&spp| spp <= options.max_spp.max(1));
+    rows.extend(stage6.clone().map(|&spp| RowKind::Gi {
+        bounces: GI_MAX_BOUNCES,
+        spp,
+    }));
+    rows.extend(stage6.map(|&spp| RowKind::Denoised { spp }));
     rows
 }
 
@@ -307,8 +347,10 @@ fn measure(
     tick: impl FnMut(),
 ) -> Row {
     let settings = kind.settings(scene);
+    let denoised = matches!(kind, RowKind::Denoised { .. });
     let render_once = || {
-        render(
+        let draw = if denoised { render_denoised } else { render };
+        draw(
             scene,
             &scene.camera(),
             scene.lights(),
@@ -356,66 +398,9 @@ fn measure(
     }
 }
 
-/// The one-minute load average, where the OS reports it (Linux).
-fn load_average() -> Option<f64> {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
-}
-
-/// The CPU model and the architecture.
-fn machine() -> String {
-    let model = std::fs::read_to_string("/proc/cpuinfo").ok().and_then(|s| {
-        s.lines()
-            .find(|l| l.starts_with("model name"))
-            .and_then(|l| l.split_once(':'))
-            .map(|(_, m)| m.trim().to_string())
-    });
-    let arch = std::env::consts::ARCH;
-    match model {
-        Some(m) => format!("{m} ({arch})"),
-        None => arch.to_string(),
-    }
-}
-
-/// Now as `YYYY-MM-DD HH:MM UTC`.
-fn utc_now() -> String {
-    let secs = SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs());
-    utc(secs)
-}
-
-/// Seconds since the Unix epoch as `YYYY-MM-DD HH:MM UTC` (the proleptic Gregorian calendar;
-/// the day count to civil date conversion of Howard Hinnant's `civil_from_days`).
-fn utc(secs: u64) -> String {
-    let days = (secs / 86_400) as i64;
-    let (hh, mm) = ((secs % 86_400) / 3600, (secs % 3600) / 60);
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    format!("{y:04}-{m:02}-{d:02} {hh:02}:{mm:02} UTC")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn dates() {
-        assert_eq!(utc(0), "1970-01-01 00:00 UTC");
-        assert_eq!(utc(951_782_400), "2000-02-29 00:00 UTC");
-        assert_eq!(utc(1_795_437_000), "2026-11-23 12:30 UTC");
-    }
 
     #[test]
     fn the_ladder_goes_up_by_four() {
@@ -432,9 +417,17 @@ mod tests {
     fn rows_cover_the_stages_aa_and_every_bounce_count() {
         let o = BenchOptions::quick();
         let rows = rows_for(&o);
-        assert_eq!(rows.len(), 5 + 2 + 4 * o.spp_ladder().len());
+        assert_eq!(rows.len(), 5 + 2 + 4 * o.spp_ladder().len() + 2 * 2);
         assert_eq!(rows[4], RowKind::Stage(Stage::Indirect));
         assert_eq!(rows[6], RowKind::Aa { spp: 16 });
-        assert_eq!(rows.last(), Some(&RowKind::Gi { bounces: 8, spp: 4 }));
+        assert_eq!(rows[6 + 4 * 2], RowKind::Gi { bounces: 8, spp: 4 });
+        assert_eq!(
+            rows[6 + 4 * 2 + 1],
+            RowKind::Gi {
+                bounces: GI_MAX_BOUNCES,
+                spp: 1
+            }
+        );
+        assert_eq!(rows.last(), Some(&RowKind::Denoised { spp: 4 }));
     }
 }

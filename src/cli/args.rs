@@ -118,6 +118,15 @@ pub(super) enum Format {
     Pfm,
 }
 
+/// An on/off switch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(super) enum Switch {
+    /// On.
+    On,
+    /// Off.
+    Off,
+}
+
 /// Options of `raytty render`.
 #[derive(Args, Debug)]
 pub(super) struct RenderArgs {
@@ -139,6 +148,10 @@ pub(super) struct RenderArgs {
     /// in the gi stage (one sample is noisy). Default: the scene's (1 for gi).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub(super) samples: Option<u32>,
+    /// Denoise the gi stage's indirect light (on, the default) or give the raw, unbiased
+    /// path-traced estimate (off). Other stages have no noise to remove.
+    #[arg(long, value_enum, default_value_t = Switch::On)]
+    pub(super) denoise: Switch,
     /// Camera position and yaw in degrees, x,y,z,yaw (default: the scene's camera).
     #[arg(long, value_name = "X,Y,Z,YAW", value_parser = parse_camera, allow_hyphen_values = true)]
     pub(super) camera: Option<[f32; 4]>,
@@ -148,6 +161,20 @@ pub(super) struct RenderArgs {
     /// Write to FILE instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub(super) output: Option<PathBuf>,
+    /// After the frame, print one line to stderr: render time in ms, samples per pixel, rays
+    /// by kind, M rays/s and the SIMD path; --stats=json prints it as one JSON object (keys ms,
+    /// spp, rays, mrays_per_s, simd, threads).
+    #[arg(long, value_name = "FORMAT", num_args = 0..=1, require_equals = true, default_missing_value = "text")]
+    pub(super) stats: Option<StatsFormat>,
+}
+
+/// How `render --stats` prints the frame's cost.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(super) enum StatsFormat {
+    /// One line for people.
+    Text,
+    /// One JSON object.
+    Json,
 }
 
 pub(super) fn parse_size(s: &str) -> Result<(u32, u32), String> {

@@ -6,6 +6,7 @@ use std::io::{self, BufWriter, IsTerminal, Write};
 use anyhow::Context;
 use clap::ValueEnum;
 use glam::Vec3;
+use raytty::denoise::render_denoised;
 use raytty::{CellGrid, ColorMode, PointLight, Scene, encode_text, render};
 
 use raytty::image::MAX_PIXELS;
@@ -83,7 +84,11 @@ pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool)
         )),
         None => Box::new(BufWriter::new(io::stdout().lock())),
     };
-    let frame = render(&scene, &camera, &lights, &settings, w, h);
+    let frame = if args.denoise == Switch::On {
+        render_denoised(&scene, &camera, &lights, &settings, w, h)
+    } else {
+        render(&scene, &camera, &lights, &settings, w, h)
+    };
     let written = match format {
         Format::Png => frame.image.write_png(&mut out),
         Format::Pfm => frame.image.write_pfm(&mut out),
@@ -96,14 +101,22 @@ pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool)
             out.write_all(&encode_text(&CellGrid::from_image(&frame.image, mode)))
         }
     };
-    Ok(written.and_then(|()| out.flush()).with_context(|| {
+    written.and_then(|()| out.flush()).with_context(|| {
         format!(
             "cannot write to {}",
             args.output
                 .as_ref()
                 .map_or_else(|| "stdout".to_string(), |p| p.display().to_string())
         )
-    })?)
+    })?;
+    match args.stats {
+        Some(StatsFormat::Text) => {
+            eprintln!("raytty: {w}x{h}, {}", frame.stats.summary(scene.isa()))
+        }
+        Some(StatsFormat::Json) => eprintln!("{}", frame.stats.to_json(scene.isa())),
+        None => {}
+    }
+    Ok(())
 }
 
 /// Whether stdout was closed when raytty started (`raytty render >&-`), as opposed to a pipe

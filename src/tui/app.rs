@@ -21,6 +21,8 @@ pub enum Message {
     CycleColor,
     /// Show or hide the key help.
     ToggleHelp,
+    /// Turn the GI denoiser on or off.
+    ToggleDenoise,
     /// The terminal now has this many columns and rows.
     Resize {
         /// Columns.
@@ -49,6 +51,8 @@ pub struct App {
     pub color: ColorMode,
     /// Whether the key help covers the frame.
     pub help: bool,
+    /// Whether the GI stage's indirect light is denoised (the raw, unbiased estimate if not).
+    pub denoise: bool,
     /// Terminal size in cells (columns, rows).
     pub size: (u16, u16),
     /// Set by [`Message::Quit`].
@@ -72,6 +76,7 @@ impl App {
             stage: Stage::Indirect,
             color,
             help: false,
+            denoise: true,
             size,
             quit: false,
             suspend: false,
@@ -128,6 +133,12 @@ pub fn update(app: &mut App, msg: Message) {
         }
         Message::ToggleHelp => {
             app.help = !app.help;
+            app.dirty = true;
+            false
+        }
+        // The samples so far are kept: the view filters them again, or shows them raw.
+        Message::ToggleDenoise => {
+            app.denoise = !app.denoise;
             app.dirty = true;
             false
         }
@@ -203,9 +214,10 @@ mod tests {
         a.dirty = false;
         update(&mut a, Message::CycleColor);
         update(&mut a, Message::ToggleHelp);
+        update(&mut a, Message::ToggleDenoise);
         assert_eq!(
-            (a.generation, a.dirty, a.color, a.help),
-            (0, true, ColorMode::Ansi256, true)
+            (a.generation, a.dirty, a.color, a.help, a.denoise),
+            (0, true, ColorMode::Ansi256, true, false)
         );
         update(&mut a, Message::SetStage(Stage::Indirect));
         update(&mut a, Message::Resize { cols: 80, rows: 24 });

@@ -24,6 +24,7 @@ pub const KEYS: &[(&str, &str)] = &[
     ("A / D", "light left / right (Shift: finer)"),
     ("Q / E", "light up / down (Shift: finer)"),
     ("1-6", "stage: flat light direct shadows indirect gi"),
+    ("N", "gi: denoiser on / off (off: raw, unbiased)"),
     ("R", "reset camera and light"),
     ("C", "colour mode: truecolor 256 ascii"),
     ("H or ?", "this help"),
@@ -75,6 +76,7 @@ pub fn message_for(key: KeyEvent) -> Option<Message> {
                 'q' => light(0.0, -1.0, 0.0),
                 'e' => light(0.0, 1.0, 0.0),
                 'r' => Some(Message::Reset),
+                'n' => Some(Message::ToggleDenoise),
                 'c' => Some(Message::CycleColor),
                 'h' | '?' => Some(Message::ToggleHelp),
                 d @ '1'..='9' => Stage::ALL
@@ -151,6 +153,7 @@ mod tests {
         assert_eq!(press('0'), None);
         assert_eq!(press('9'), None);
         assert_eq!(press('R'), Some(Message::Reset));
+        assert_eq!(press('n'), Some(Message::ToggleDenoise));
         assert_eq!(press('c'), Some(Message::CycleColor));
         assert_eq!(press('?'), Some(Message::ToggleHelp));
         assert_eq!(press('h'), Some(Message::ToggleHelp));

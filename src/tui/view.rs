@@ -6,8 +6,11 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use raytty::bench::timing::ms;
+use raytty::denoise::{Guides, denoise};
 use raytty::frame::{DiffLimits, UNLIKE, distance, encode_diff_within};
-use raytty::{CellGrid, FrameStats, HitCache, Image, Stage, printable, render_cached};
+use raytty::{
+    Camera, CellGrid, FrameStats, HitCache, Image, Stage, printable, render_cached, render_guided,
+};
 
 use super::app::App;
 use super::link::describe;
@@ -20,6 +23,13 @@ pub const MIN_ROWS: u16 = 3;
 /// Progressive refinement in the GI stage stops after this many passes (one sample per pixel
 /// each); the app is then idle.
 pub const GI_MAX_PASSES: u32 = 256;
+
+/// After a move of the light alone, the GI samples gathered before it keep at most this much
+/// weight (in samples) against the new ones: the direct light is exact and recomputed at once,
+/// and the indirect light, which changes slowly with the light, is not thrown away with it.
+/// So while a light key is held the indirect light lags by a few frames at most, and stays
+/// about this many samples clean; a camera move restarts from nothing.
+pub const LIGHT_MOVE_HISTORY: u32 = 4;
 
 /// The too-small message, line by line, each from its longest wording to its shortest: the
 /// longest that fits the terminal's width is shown.
@@ -54,9 +64,17 @@ pub struct Screen {
     cache: HitCache,
     /// The app generation the image shows, once rendered.
     generation: Option<u64>,
-    /// Sum of the progressive passes so far.
-    sum: Vec<Vec3>,
+    /// The GI passes so far, as the denoiser's guides (means over the passes).
+    guides: Option<Guides>,
     passes: u32,
+    /// What the GI guides were rendered for: camera and size.
+    gi_view: Option<(Camera, (u32, u32))>,
+    /// Whether the image shows the GI passes denoised (`None`: not GI, or not yet shown).
+    shows_denoised: Option<bool>,
+    /// Render and filter time spent on the current GI image since it restarted.
+    spent: Duration,
+    /// Estimated RMSE of the raw GI estimate and of the image shown (from the variance).
+    error: (f32, f32),
     image: Image,
     /// What the terminal shows now.
     shown: Option<CellGrid>,
@@ -99,8 +117,12 @@ impl Screen {
         Screen {
             cache: HitCache::new(),
             generation: None,
-            sum: Vec::new(),
+            guides: None,
             passes: 0,
+            gi_view: None,
+            shows_denoised: None,
+            spent: Duration::ZERO,
+            error: (0.0, 0.0),
             image: Image::new(0, 0),
             shown: None,
             next_row: 0,
@@ -121,52 +143,96 @@ impl Screen {
         self.passes
     }
 
-    /// Whether [`Screen::render`] has work to do: the app changed, or GI is still refining.
+    /// Whether [`Screen::render`] has work to do: the app changed, GI is still refining, or
+    /// the denoiser was switched.
     pub fn needs_render(&self, app: &App) -> bool {
         image_size(app.size).is_some()
             && (self.generation != Some(app.generation)
-                || (app.stage == Stage::Gi && self.passes < GI_MAX_PASSES))
+                || (app.stage == Stage::Gi
+                    && (self.passes < GI_MAX_PASSES || self.shows_denoised != Some(app.denoise))))
     }
 
     /// Renders one frame, or one more progressive pass in the GI stage (which restarts when
-    /// the app's generation changes). Does nothing if the terminal is too small.
+    /// the app's generation changes, but for a light move, which keeps a bounded history: see
+    /// [`LIGHT_MOVE_HISTORY`]). Does nothing if the terminal is too small.
     pub fn render(&mut self, app: &App) {
         let Some((w, h)) = image_size(app.size) else {
             return;
         };
+        let mut history = u32::MAX;
         if self.generation != Some(app.generation) {
             self.generation = Some(app.generation);
             self.passes = 0;
-            self.sum.clear();
+            self.spent = Duration::ZERO;
+            let same_view = self
+                .gi_view
+                .as_ref()
+                .is_some_and(|(c, size)| *c == app.camera && *size == (w, h));
+            if app.stage == Stage::Gi && same_view {
+                history = LIGHT_MOVE_HISTORY;
+            } else {
+                self.guides = None;
+            }
         }
         let mut settings = app.stage.settings(app.scene.effects());
         settings.frame = self.passes;
-        let frame = render_cached(
-            &app.scene,
-            &app.camera,
-            &app.lights,
-            &settings,
-            w,
-            h,
-            &mut self.cache,
-        );
-        self.stats.render = frame.stats;
-        if app.stage == Stage::Gi {
-            self.sum.resize(frame.image.pixels.len(), Vec3::ZERO);
-            for (s, p) in self.sum.iter_mut().zip(&frame.image.pixels) {
-                *s += *p;
+        if app.stage != Stage::Gi {
+            let frame = render_cached(
+                &app.scene,
+                &app.camera,
+                &app.lights,
+                &settings,
+                w,
+                h,
+                &mut self.cache,
+            );
+            self.stats.render = frame.stats;
+            self.passes = GI_MAX_PASSES;
+            self.guides = None;
+            self.gi_view = None;
+            self.shows_denoised = None;
+            self.image = frame.image;
+            return;
+        }
+        if self.passes < GI_MAX_PASSES {
+            let frame = render_guided(
+                &app.scene,
+                &app.camera,
+                &app.lights,
+                &settings,
+                w,
+                h,
+                &mut self.cache,
+            );
+            self.stats.render = frame.stats;
+            self.spent += frame.stats.elapsed;
+            if let Some(new) = frame.guides {
+                match &mut self.guides {
+                    Some(g) if history != u32::MAX || self.passes > 0 => {
+                        g.accumulate(&new, history)
+                    }
+                    _ => self.guides = Some(new),
+                }
             }
             self.passes += 1;
-            let scale = 1.0 / self.passes as f32;
-            self.image = Image {
-                width: w,
-                height: h,
-                pixels: self.sum.iter().map(|&s| s * scale).collect(),
-            };
-        } else {
-            self.passes = GI_MAX_PASSES;
-            self.image = frame.image;
+            self.gi_view = Some((app.camera, (w, h)));
         }
+        let Some(g) = &self.guides else { return };
+        let start = Instant::now();
+        let d = denoise(g);
+        if app.denoise {
+            self.spent += start.elapsed();
+            self.error = (d.raw_error, d.error);
+            self.image = d.image;
+        } else {
+            self.error = (d.raw_error, d.raw_error);
+            self.image = Image {
+                width: g.width,
+                height: g.height,
+                pixels: g.raw(),
+            };
+        }
+        self.shows_denoised = Some(app.denoise);
     }
 
     /// Whether the terminal shows only an approximation of the latest frame (the link's budget
@@ -231,16 +297,34 @@ impl Screen {
     /// name comes from a file: its control characters are removed.
     fn status(&self, app: &App) -> String {
         let key = Stage::ALL.iter().position(|&s| s == app.stage).unwrap_or(0) + 1;
-        let spp = if app.stage == Stage::Gi {
+        let gi = app.stage == Stage::Gi;
+        let spp = if gi {
             format!(" {}/{GI_MAX_PASSES}spp", self.passes)
         } else {
             String::new()
         };
+        // The price, live: the time spent on this image and its error estimated from the
+        // per-pixel variance (denoised: the noise left after the filter, then the raw one's).
+        let (raw, shown) = self.error;
+        let price = if !gi {
+            String::new()
+        } else if app.denoise {
+            format!("{:.2}s ±{shown:.4} raw ±{raw:.3}", self.spent.as_secs_f64())
+        } else {
+            format!("{:.2}s ±{raw:.4}", self.spent.as_secs_f64())
+        };
+        let filter = match (gi, app.denoise) {
+            (false, _) => String::new(),
+            (true, true) => "N:denoised".to_string(),
+            (true, false) => "N:raw".to_string(),
+        };
         let light = app.light().map_or_else(|| "none".into(), xyz);
         // (text, rank): rank 0 is always shown, then the lowest ranks first while they fit.
-        let fields = [
+        let mut fields = vec![
             (printable(app.scene.name()), 0),
             (format!("{key}:{}{spp}", app.stage.name()), 0),
+            (price, 1),
+            (filter, 2),
             (
                 format!(
                     "cam {} {}°",
@@ -265,6 +349,7 @@ impl Screen {
             (app.color.name().to_string(), 6),
             ("H:help".to_string(), 2),
         ];
+        fields.retain(|(t, _)| !t.is_empty());
         fit_status(&fields, app.size.0 as usize)
     }
 }
@@ -446,6 +531,65 @@ mod tests {
         assert!(s.needs_render(&a));
         s.render(&a);
         assert_eq!(s.passes(), 1);
+    }
+
+    #[test]
+    fn gi_shows_its_price_and_the_denoiser_switch_refilters_without_a_new_pass() {
+        let mut a = app(200, 16);
+        update(&mut a, Message::SetStage(Stage::Gi));
+        let mut s = Screen::new();
+        for _ in 0..4 {
+            s.render(&a);
+        }
+        let status = s.status(&a);
+        assert!(status.contains("6:gi 4/256spp"), "{status}");
+        assert!(
+            status.contains("N:denoised") && status.contains(" raw ±"),
+            "{status}"
+        );
+        let denoised = s.image.clone();
+        let (raw_error, error) = s.error;
+        assert!(error < raw_error && raw_error > 0.0, "{:?}", s.error);
+        // Off: the passes so far, raw, plus the next one.
+        update(&mut a, Message::ToggleDenoise);
+        assert!(s.needs_render(&a));
+        s.render(&a);
+        assert_eq!(s.passes(), 5);
+        update(&mut a, Message::ToggleDenoise);
+        s.render(&a);
+        assert_ne!(s.image, denoised, "passes were added");
+        let mut capped = Screen::new();
+        let mut b = app(80, 4);
+        update(&mut b, Message::SetStage(Stage::Gi));
+        while capped.needs_render(&b) {
+            capped.render(&b);
+        }
+        let before = capped.image.clone();
+        update(&mut b, Message::ToggleDenoise);
+        assert!(capped.needs_render(&b));
+        capped.render(&b);
+        assert_eq!(capped.passes(), GI_MAX_PASSES, "no pass past the cap");
+        assert_ne!(capped.image, before);
+        assert!(capped.status(&b).contains("N:raw"));
+        assert!(!capped.needs_render(&b));
+    }
+
+    #[test]
+    fn a_light_move_in_gi_keeps_a_bounded_history_and_a_camera_move_none() {
+        let mut a = app(40, 13);
+        update(&mut a, Message::SetStage(Stage::Gi));
+        let mut s = Screen::new();
+        for _ in 0..10 {
+            s.render(&a);
+        }
+        assert_eq!(s.guides.as_ref().unwrap().samples, 10);
+        update(&mut a, Message::MoveLight(Vec3::new(0.1, 0.0, 0.0)));
+        s.render(&a);
+        assert_eq!(s.passes(), 1);
+        assert_eq!(s.guides.as_ref().unwrap().samples, LIGHT_MOVE_HISTORY + 1);
+        update(&mut a, Message::Walk(0.1));
+        s.render(&a);
+        assert_eq!(s.guides.as_ref().unwrap().samples, 1);
     }
 
     #[test]

@@ -100,18 +100,26 @@ impl Ctx<'_> {
 }
 
 /// A TOML or serde error as a positioned message; unknown keys get a suggestion.
+///
+/// This reads serde's English messages: `toml::de::Error` keeps only a message and a span,
+/// and serde's derived code reports an unknown or missing field through
+/// `de::Error::unknown_field` / `missing_field`, whose default forms are text. The tests below
+/// build errors with those very constructors, so a change of wording in serde or toml fails
+/// them by name rather than degrading the messages in silence.
 pub fn toml_error(cx: &Ctx, e: &toml::de::Error) -> SceneFileError {
     let offset = e.span().map_or(0, |s| s.start);
     let message = e.message().trim().replace('\n', "; ");
     let message = if let Some(rest) = message.strip_prefix("unknown field `") {
-        let key = rest.split('`').next().unwrap_or("");
-        let known: Vec<&str> = rest
-            .split('`')
-            .skip(1)
-            .collect::<Vec<_>>()
-            .chunks(2)
-            .filter_map(|c| c.get(1).copied())
-            .collect();
+        // serde: "unknown field `KEY`, expected `a`" / "… one of `a`, `b`" / "… `a` or `b`",
+        // or "unknown field `KEY`, there are no fields". KEY may itself hold backticks.
+        let (key, expected) = rest
+            .rsplit_once("`, expected ")
+            .or_else(|| {
+                rest.rsplit_once("`, there are no fields")
+                    .map(|(k, _)| (k, ""))
+            })
+            .unwrap_or((rest.trim_end_matches('`'), ""));
+        let known: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
         format!(
             "unknown key `{key}`{} (keys here: {})",
             did_you_mean(key, &known),
@@ -122,7 +130,7 @@ pub fn toml_error(cx: &Ctx, e: &toml::de::Error) -> SceneFileError {
             }
         )
     } else if let Some(rest) = message.strip_prefix("missing field `") {
-        let key = rest.split('`').next().unwrap_or("");
+        let key = rest.strip_suffix('`').unwrap_or(rest);
         let form = KEY_FORMS
             .iter()
             .find(|k| k.0 == key)
@@ -151,4 +159,55 @@ pub fn toml_error(cx: &Ctx, e: &toml::de::Error) -> SceneFileError {
             )
     };
     cx.err(offset, message)
+}
+
+#[cfg(test)]
+mod tests {
+    use serde::de::{Error as _, Unexpected};
+
+    use super::*;
+
+    /// The message [`toml_error`] makes of an error built by serde's own constructor.
+    fn shown(e: toml::de::Error) -> String {
+        let cx = Ctx {
+            source: "",
+            file: "f.toml",
+        };
+        toml_error(&cx, &e).message
+    }
+
+    #[test]
+    fn serde_field_errors_become_toml_messages() {
+        let e = toml::de::Error::unknown_field("mirorr", &["colour", "mirror"]);
+        assert_eq!(
+            shown(e),
+            "unknown key `mirorr`; did you mean `mirror`? (keys here: colour, mirror)"
+        );
+        let e = toml::de::Error::unknown_field("zoom", &["position", "yaw", "pitch"]);
+        assert_eq!(
+            shown(e),
+            "unknown key `zoom` (keys here: position, yaw, pitch)"
+        );
+        let e = toml::de::Error::unknown_field("a`, expected `b", &["kind"]);
+        assert_eq!(shown(e), "unknown key `a`, expected `b` (keys here: kind)");
+        let e = toml::de::Error::unknown_field("x", &[]);
+        assert_eq!(shown(e), "unknown key `x` (keys here: none)");
+        let e = toml::de::Error::missing_field("power");
+        assert_eq!(
+            shown(e),
+            "missing key `power` in this table: add power = 14 (or [r, g, b])"
+        );
+        let e = toml::de::Error::duplicate_field("yaw");
+        assert_eq!(shown(e), "duplicate key `yaw`");
+    }
+
+    #[test]
+    fn serde_type_errors_use_toml_words() {
+        let e = toml::de::Error::invalid_type(Unexpected::Str("x"), &"f64");
+        assert_eq!(shown(e), "invalid type: string \"x\", expected a number");
+        let e = toml::de::Error::invalid_type(Unexpected::Map, &"i64");
+        assert_eq!(shown(e), "invalid type: table, expected a whole number");
+        let e = toml::de::Error::invalid_type(Unexpected::Seq, &"a boolean");
+        assert_eq!(shown(e), "invalid type: array, expected true or false");
+    }
 }
