@@ -6,12 +6,12 @@
 //! screen was within 8 levels per channel of the final frame, and exact.
 //!
 //! Run: `cargo build --release && cargo run --release --example slow_link`
-//! (one case: `... -- 120x40 w 1`; a size, `w` or `right`, Mbit/s).
+//! (one case: `... -- 120x40 w 1`: a size, `w` or `right`, Mbit/s; the emulator alone, draining
+//! 2 MB: `... -- check 10`).
 
 #[path = "../tests/support/slow_link.rs"]
 mod slow_link;
 
-use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
@@ -63,30 +63,6 @@ fn expected(cols: u16, rows: u16, motion: Motion, presses: usize) -> CellGrid {
     CellGrid::from_image(&frame.image, ColorMode::TrueColor)
 }
 
-/// When the screen first came within [`CLOSE`] of the final frame, and first matched it.
-#[derive(Default)]
-struct Probe {
-    release: Option<Instant>,
-    close: Option<Instant>,
-    exact: Option<(Instant, usize)>,
-    last_check: Option<Instant>,
-    /// The last read, and the bytes by then, if it was not checked.
-    unchecked: Option<(Instant, usize)>,
-}
-
-impl Probe {
-    fn check(&mut self, screen: &vt100::Screen, want: &CellGrid, bytes: usize, at: Instant) {
-        self.unchecked = None;
-        let e = max_error(screen, want);
-        if e <= CLOSE && self.close.is_none() {
-            self.close = Some(at);
-        }
-        if e == 0 {
-            self.exact = Some((at, bytes));
-        }
-    }
-}
-
 struct Row {
     bytes: usize,
     close: Option<f64>,
@@ -95,32 +71,14 @@ struct Row {
 
 fn run(binary: &str, cols: u16, rows: u16, motion: Motion, mbit: f64) -> Row {
     let start = expected(cols, rows, motion, 0);
-    let end = Arc::new(expected(cols, rows, motion, PRESSES));
-    let probe = Arc::new(Mutex::new(Probe::default()));
-    let (p, want) = (probe.clone(), end.clone());
-    let watch = move |screen: &vt100::Screen, bytes: usize, now: Instant| {
-        let mut p = p.lock().expect("probe");
-        if p.release.is_none() || p.exact.is_some() {
-            return;
-        }
-        // A check costs about a millisecond: at most one per half millisecond of reading (the
-        // main thread checks a read left unchecked once the link goes quiet).
-        if p.last_check
-            .is_some_and(|t| now - t < Duration::from_micros(500))
-        {
-            p.unchecked = Some((now, bytes));
-            return;
-        }
-        p.last_check = Some(now);
-        p.check(screen, &want, bytes, now);
-    };
+    let end = expected(cols, rows, motion, PRESSES);
     let rate = mbit * 1e6 / 8.0;
-    let mut link = SlowLink::start(binary, &["--color", "truecolor"], cols, rows, rate, watch);
+    let mut link = SlowLink::start(binary, &["--color", "truecolor"], cols, rows, rate);
     assert!(
         link.wait_for(PATIENCE, |s| max_error(s, &start) == 0),
         "the first frame never showed"
     );
-    let bytes_before = link.far.lock().expect("far").bytes;
+    let bytes_before = link.snapshot().1;
     let key: &[u8] = match motion {
         Motion::Light => b"w",
         Motion::Turn => b"\x1b[C",
@@ -132,35 +90,39 @@ fn run(binary: &str, cols: u16, rows: u16, motion: Motion, mbit: f64) -> Row {
         link.send(key);
     }
     let release = Instant::now();
-    probe.lock().expect("probe").release = Some(release);
-    let deadline = release + PATIENCE;
-    while probe.lock().expect("probe").exact.is_none() && Instant::now() < deadline {
-        std::thread::sleep(Duration::from_millis(2));
-        let far = link.far.lock().expect("far");
-        let mut p = probe.lock().expect("probe");
-        if let Some((at, bytes)) = p.unchecked
-            && Instant::now() - at > Duration::from_millis(2)
-        {
-            p.check(far.screen.screen(), &end, bytes, at);
+    // Judge the screen as of each read (copied out, so judging never slows the link).
+    let (mut close, mut exact) = (None, None);
+    let mut judged = None;
+    while exact.is_none() && release.elapsed() < PATIENCE {
+        let (screen, bytes, last_read) = link.snapshot();
+        if last_read == judged || last_read.is_none_or(|t| t < release) {
+            std::thread::sleep(Duration::from_micros(200));
+            continue;
+        }
+        judged = last_read;
+        let at = last_read
+            .expect("a read")
+            .saturating_duration_since(release);
+        let e = max_error(&screen, &end);
+        if e <= CLOSE && close.is_none() {
+            close = Some(at.as_secs_f64());
+        }
+        if e == 0 {
+            exact = Some((at.as_secs_f64(), bytes));
         }
     }
     if std::env::var_os("SLOW_LINK_DEBUG").is_some() {
-        let far = link.far.lock().expect("far");
-        let scr = far.screen.screen();
+        let (scr, _, _) = link.snapshot();
         eprintln!(
-            "error to the final frame {}, to the start {}; status: {}",
-            max_error(scr, &end),
-            max_error(scr, &start),
+            "error to the final frame {}; status: {}",
+            max_error(&scr, &end),
             scr.contents_between(rows - 1, 0, rows - 1, cols)
         );
     }
-    let p = probe.lock().expect("probe");
-    let secs = |t: Instant| t.saturating_duration_since(release).as_secs_f64();
-    let total = link.far.lock().expect("far").bytes;
     Row {
-        bytes: p.exact.map_or(total, |(_, b)| b) - bytes_before,
-        close: p.close.map(secs),
-        exact: p.exact.map(|(t, _)| secs(t)),
+        bytes: exact.map_or(link.snapshot().1, |(_, b)| b) - bytes_before,
+        close,
+        exact: exact.map(|(t, _)| t),
     }
 }
 
@@ -184,6 +146,26 @@ fn main() {
                 cases.push((cols, rows, motion, mbit));
             }
         }
+    }
+    if let [check, mbit] = &args[..]
+        && check == "check"
+    {
+        // The emulator alone: how fast it drains 2 MB written as fast as possible.
+        let rate = mbit.parse::<f64>().expect("Mbit/s") * 1e6 / 8.0;
+        let link = SlowLink::start(
+            "sh",
+            &["-c", "head -c 2000000 /dev/zero | tr '\\0' x"],
+            200,
+            50,
+            rate,
+        );
+        let t = Instant::now();
+        while link.snapshot().1 < 2_000_000 && t.elapsed() < PATIENCE {
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        let secs = t.elapsed().as_secs_f64();
+        println!("2 MB in {secs:.2} s: {:.1} Mbit/s", 16.0 / secs);
+        return;
     }
     if let [size, key, mbit] = &args[..] {
         let (c, r) = size.split_once('x').expect("COLSxROWS");

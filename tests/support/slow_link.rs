@@ -12,11 +12,12 @@ use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system}
 use raytty::CellGrid;
 use raytty::frame::{Colour, pixels};
 
-/// The most the link lets through at once after an idle spell: a few milliseconds' worth at
-/// 1 Mbit/s (a real link's queue and the terminal's read size).
-const BURST: f64 = 2048.0;
-/// Longest read: about what a terminal reads per wake-up.
-const READ_MAX: usize = 4096;
+/// The most the link lets through at once after an idle spell, in time at its rate (a real
+/// link's queue): long enough that the reader's own scheduling delays on a busy machine do not
+/// slow the link down.
+const BURST: Duration = Duration::from_millis(10);
+/// Longest read.
+const READ_MAX: usize = 65536;
 /// How often the reader wakes while waiting for the link's next bytes.
 const TICK: Duration = Duration::from_millis(1);
 
@@ -28,6 +29,8 @@ pub struct Far {
     pub bytes: usize,
     /// The program closed the pty.
     pub closed: bool,
+    /// When the last bytes were read.
+    pub last_read: Option<Instant>,
 }
 
 /// A program on the far side of a link of `rate` bytes per second.
@@ -40,15 +43,7 @@ pub struct SlowLink {
 
 impl SlowLink {
     /// Starts `program` with `args` in a `cols × rows` pty drained at `rate` bytes per second.
-    /// `watch` is called after every read with the screen, the bytes so far and the time.
-    pub fn start(
-        program: &str,
-        args: &[&str],
-        cols: u16,
-        rows: u16,
-        rate: f64,
-        mut watch: impl FnMut(&vt100::Screen, usize, Instant) + Send + 'static,
-    ) -> SlowLink {
+    pub fn start(program: &str, args: &[&str], cols: u16, rows: u16, rate: f64) -> SlowLink {
         let pair = native_pty_system()
             .openpty(PtySize {
                 rows,
@@ -73,6 +68,7 @@ impl SlowLink {
             ),
             bytes: 0,
             closed: false,
+            last_read: None,
         }));
         let shared = far.clone();
         std::thread::spawn(move || {
@@ -83,7 +79,7 @@ impl SlowLink {
                 // A token bucket: what the link has carried by now, less what was read, at most
                 // a burst.
                 let carried = rate * start.elapsed().as_secs_f64();
-                read = read.max(carried - BURST);
+                read = read.max(carried - rate * BURST.as_secs_f64());
                 let allowed = (carried - read).floor();
                 if allowed < 1.0 {
                     std::thread::sleep(TICK);
@@ -99,8 +95,7 @@ impl SlowLink {
                 let mut far = shared.lock().expect("the far end");
                 far.screen.process(&buf[..n]);
                 far.bytes += n;
-                let bytes = far.bytes;
-                watch(far.screen.screen(), bytes, now);
+                far.last_read = Some(now);
             }
             shared.lock().expect("the far end").closed = true;
         });
@@ -119,10 +114,11 @@ impl SlowLink {
     }
 
     /// Waits until `cond` holds for the far end's screen, at most `limit`; whether it did.
-    pub fn wait_for(&self, limit: Duration, cond: impl Fn(&vt100::Screen) -> bool) -> bool {
+    /// The screen is copied out of the lock, so judging it never holds up the link.
+    pub fn wait_for(&self, limit: Duration, mut cond: impl FnMut(&vt100::Screen) -> bool) -> bool {
         let deadline = Instant::now() + limit;
         loop {
-            if cond(self.far.lock().expect("the far end").screen.screen()) {
+            if cond(&self.snapshot().0) {
                 return true;
             }
             if Instant::now() > deadline {
@@ -130,6 +126,12 @@ impl SlowLink {
             }
             std::thread::sleep(TICK);
         }
+    }
+
+    /// A copy of the far end's screen, the bytes read and when the last were read.
+    pub fn snapshot(&self) -> (vt100::Screen, usize, Option<Instant>) {
+        let far = self.far.lock().expect("the far end");
+        (far.screen.screen().clone(), far.bytes, far.last_read)
     }
 
     /// The pty's master side (to resize it).
