@@ -265,3 +265,50 @@ fn sum(mut a: RayCounts, b: RayCounts) -> RayCounts {
     a += b;
     a
 }
+
+impl FrameStats {
+    /// Millions of rays (all kinds) per second of the render's wall-clock time.
+    pub fn mrays_per_s(&self) -> f64 {
+        let s = self.elapsed.as_secs_f64();
+        if s > 0.0 {
+            self.rays.total() as f64 / s / 1e6
+        } else {
+            0.0
+        }
+    }
+
+    /// One line for people: time, samples, rays by kind, M rays/s and the SIMD path.
+    pub fn summary(&self, isa: crate::accel::Isa) -> String {
+        let r = &self.rays;
+        format!(
+            "{:.2} ms, {} spp, rays: {} primary, {} shadow, {} bounce, {} reflection; {:.2} M rays/s ({}, {} threads)",
+            self.elapsed.as_secs_f64() * 1e3,
+            self.samples,
+            r.primary,
+            r.shadow,
+            r.bounce,
+            r.reflection,
+            self.mrays_per_s(),
+            isa.name(),
+            rayon::current_num_threads()
+        )
+    }
+
+    /// The same as one JSON object: `ms`, `spp`, `rays` (by kind), `mrays_per_s`, and the
+    /// `simd` path and `threads`.
+    pub fn to_json(&self, isa: crate::accel::Isa) -> String {
+        let r = &self.rays;
+        format!(
+            "{{\"ms\":{:.3},\"spp\":{},\"rays\":{{\"primary\":{},\"shadow\":{},\"bounce\":{},\"reflection\":{}}},\"mrays_per_s\":{:.3},\"simd\":\"{}\",\"threads\":{}}}",
+            self.elapsed.as_secs_f64() * 1e3,
+            self.samples,
+            r.primary,
+            r.shadow,
+            r.bounce,
+            r.reflection,
+            self.mrays_per_s(),
+            isa.name(),
+            rayon::current_num_threads()
+        )
+    }
+}

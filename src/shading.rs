@@ -483,7 +483,7 @@ impl<'a> Tracer<'a> {
 }
 
 /// A cosine-weighted direction on the hemisphere around `n` (unit length).
-fn cosine_sample(n: Vec3, rng: &mut Rng) -> Vec3 {
+pub(crate) fn cosine_sample(n: Vec3, rng: &mut Rng) -> Vec3 {
     let (u1, u2) = (rng.next_f32(), rng.next_f32());
     let r = u1.sqrt();
     let phi = 2.0 * PI * u2;

@@ -41,14 +41,34 @@ fn text(b: &[u8]) -> String {
 const ROWS_PER_SIZE: usize = 5 + 2 + 4 * 2 + 2 * 2;
 const SIZES: usize = 2;
 
+/// The throughput section's table: header, alignment, and one row per ray kind (the quick
+/// bench measures the Cornell box only).
+const THROUGHPUT_LINES: usize = 2 + 4;
+
 #[test]
 fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
     let dir = TempDir::new("table");
     let out = bench(&dir.0, &[]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
-    let table: Vec<&str> = stdout.lines().filter(|l| l.starts_with('|')).collect();
+    let (accuracy, throughput) = stdout
+        .split_once("Ray throughput")
+        .expect("a throughput section");
+    let table: Vec<&str> = accuracy.lines().filter(|l| l.starts_with('|')).collect();
     assert_eq!(table.len(), 2 + SIZES * ROWS_PER_SIZE, "{stdout}");
+    let rates: Vec<&str> = throughput.lines().filter(|l| l.starts_with('|')).collect();
+    assert_eq!(rates.len(), THROUGHPUT_LINES, "{stdout}");
+    for (row, kind) in rates[2..]
+        .iter()
+        .zip(["primary", "shadow", "bounce", "reflection"])
+    {
+        let cells: Vec<&str> = row.trim_matches('|').split('|').map(str::trim).collect();
+        assert_eq!(cells[0], "cornell", "{row}");
+        assert_eq!(cells[4], kind, "{row}");
+        for rate in &cells[6..] {
+            assert!(rate.parse::<f64>().is_ok_and(|r| r > 0.0), "{row}");
+        }
+    }
     assert_eq!(
         table
             .iter()
@@ -301,7 +321,7 @@ fn the_readme_changes_only_between_the_markers() {
     assert!(!inner.contains("old table"));
     assert_eq!(
         inner.lines().filter(|l| l.starts_with('|')).count(),
-        2 + SIZES * ROWS_PER_SIZE
+        2 + SIZES * ROWS_PER_SIZE + THROUGHPUT_LINES
     );
     // The table in the README is the one printed.
     assert_eq!(inner.trim(), text(&out.stdout).trim());

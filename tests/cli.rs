@@ -301,6 +301,16 @@ fn a_closed_stdout_is_an_error_and_a_closed_pipe_is_not() {
             "raytty: stdout is closed: there is nowhere to write the frame (redirect it, or give -o FILE)\n"
         );
     }
+    // The list and the bench's table likewise.
+    for (args, what) in [("scenes", "the list"), ("bench --quick", "the table")] {
+        let out = with_stdout_closed(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args}: {err}");
+        assert_eq!(
+            err,
+            format!("raytty: stdout is closed: there is nowhere to write {what} (redirect it)\n")
+        );
+    }
     // With -o the frame does not go to stdout, so a closed one does not matter.
     let file = std::env::temp_dir().join(format!("raytty-closed-{}.txt", std::process::id()));
     let out = with_stdout_closed(&format!("render --size 8x4 -o {}", file.display()));

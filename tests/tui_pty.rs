@@ -9,6 +9,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant};
 
+#[path = "support/slow_link.rs"]
+mod slow_link;
+
 use glam::Vec3;
 use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system};
 use raytty::frame::Colour;
@@ -600,4 +603,52 @@ fn wide_and_bidi_scene_names_keep_the_status_line_on_one_row() {
             "{c:?} reached the terminal"
         );
     }
+}
+
+#[test]
+fn over_a_slow_link_a_move_is_sent_approximately_then_settles_exact() {
+    // 60 kB/s: the first 100x30 frame (about 70 kB) fills the pty, so the app measures the
+    // link; a light move of five steps is then far over a frame's budget (about 3 kB).
+    let (cols, rows) = (100u16, 30u16);
+    let mut link = slow_link::SlowLink::start(
+        env!("CARGO_BIN_EXE_raytty"),
+        &["--color", "truecolor"],
+        cols,
+        rows,
+        60_000.0,
+    );
+    let start = expected(cols, rows, 0.0, 0.0);
+    assert!(
+        link.wait_for(TIMEOUT, |s| slow_link::max_error(s, &start) == 0),
+        "the first frame never showed"
+    );
+    link.send(b"wwwww");
+    let scene = cornell_box();
+    let camera = scene.camera();
+    let mut lights = scene.lights().to_vec();
+    for _ in 0..5 {
+        lights[0].position += camera.to_world(Vec3::new(0.0, 0.0, 1.0) * (0.1 * 1.0));
+    }
+    let settings = Stage::Indirect.settings(scene.effects());
+    let frame = render(
+        &scene,
+        &camera,
+        &lights,
+        &settings,
+        cols as u32,
+        2 * (rows as u32 - 1),
+    );
+    let moved = CellGrid::from_image(&frame.image, ColorMode::TrueColor);
+    // The status line says so while the screen is approximate (for many frames at 60 kB/s).
+    let mut seen_approximate = false;
+    let settled = link.wait_for(TIMEOUT, |s| {
+        let status = s.contents_between(rows - 1, 0, rows - 1, cols);
+        seen_approximate |= status.contains("approximate");
+        slow_link::max_error(s, &moved) == 0 && !status.contains("approximate")
+    });
+    assert!(settled, "the screen never settled on the exact frame");
+    assert!(
+        seen_approximate,
+        "the move was never shown approximately: the link was not measured"
+    );
 }

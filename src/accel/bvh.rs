@@ -21,12 +21,19 @@
 //!   broken by index.
 
 mod build;
+mod node;
 
-use glam::Vec3;
 use rayon::prelude::*;
 
-use super::hit::{Hit, cull_bound, shrunk_t_max};
-use crate::geometry::{Ray, Triangle, gamma, intersect_watertight};
+use super::hit::{Hit, cull_bound};
+use super::isa::Isa;
+#[cfg(target_arch = "x86_64")]
+use super::tri4::{Avx2, Sse2};
+use super::tri4::{
+    Closest, Kernel, LANES, Portable, RayLanes, Tri4, blocks_closest, blocks_occluded,
+};
+use crate::geometry::{Ray, Triangle};
+use node::{Node, NodePair, Pair};
 
 pub use build::{LEAF_MAX, SAH_BINS};
 
@@ -34,173 +41,16 @@ pub use build::{LEAF_MAX, SAH_BINS};
 /// median splits deep down, so traversal can use a fixed stack.
 pub const MAX_DEPTH: usize = 64;
 
-/// The far side of a slab is widened by this factor (pbrt-v4's 1 + 2γ₃), so that rounding in
-/// the two slab distances never culls a box the ray grazes.
-#[inline]
-fn far_widen() -> f32 {
-    1.0 + 2.0 * gamma(3)
-}
-
-/// One node as the builder makes it: a box, and either two children (adjacent: a
-/// [`NodePair`]) or a run of triangles. 32 bytes; traversal reads them rearranged in [`Pair`]s.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C)]
-pub(crate) struct Node {
-    min: Vec3,
-    /// Leaf: index of its first triangle in leaf order. Interior: index of its first child
-    /// (even; the second child follows it in the same pair).
-    offset: u32,
-    max: Vec3,
-    /// Leaf: number of triangles (at least 1). Interior: 0.
-    count: u32,
-}
-
-const _: () = assert!(std::mem::size_of::<Node>() == 32);
-
-/// Two sibling nodes, as built.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(64))]
-pub(crate) struct NodePair(pub(crate) [Node; 2]);
-
-impl Node {
-    /// Filler for the root's pair (never visited).
-    const UNUSED: Node = Node {
-        min: Vec3::INFINITY,
-        offset: 0,
-        max: Vec3::NEG_INFINITY,
-        count: 0,
-    };
-
-    #[inline]
-    fn is_leaf(&self) -> bool {
-        self.count > 0
-    }
-}
-
-/// Two sibling nodes as traversal reads them, in one 64-byte cache line: the boxes laid out
-/// slab by slab, so that both children's slab distances along an axis come from one 4-wide
-/// operation.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(64))]
-struct Pair {
-    /// Per axis: `[min of child 0, min of child 1, max of child 0, max of child 1]`.
-    slabs: [[f32; 4]; 3],
-    /// Each child's [`Node::offset`].
-    offset: [u32; 2],
-    /// Each child's [`Node::count`].
-    count: [u32; 2],
-}
-
-const _: () = assert!(std::mem::size_of::<Pair>() == 64);
-
-impl Pair {
-    fn new(NodePair(n): NodePair) -> Pair {
-        Pair {
-            slabs: [0, 1, 2].map(|a| [n[0].min[a], n[1].min[a], n[0].max[a], n[1].max[a]]),
-            offset: [n[0].offset, n[1].offset],
-            count: [n[0].count, n[1].count],
-        }
-    }
-
-    /// The node in lane `lane`.
-    fn node(&self, lane: usize) -> Node {
-        let s = &self.slabs;
-        Node {
-            min: Vec3::new(s[0][lane], s[1][lane], s[2][lane]),
-            offset: self.offset[lane],
-            max: Vec3::new(s[0][lane + 2], s[1][lane + 2], s[2][lane + 2]),
-            count: self.count[lane],
-        }
-    }
-
-    /// Robust slab test of both boxes: where the ray enters each, if it meets it for some `t`
-    /// in `[0, t_max]`. The far distance is widened by 1 + 2γ₃; a NaN slab distance (the
-    /// origin on a slab plane of a ray parallel to it) constrains nothing, so such a box is
-    /// kept. This is the portable form; x86-64 runs the same operations four lanes at a time.
-    #[cfg(not(target_arch = "x86_64"))]
-    #[inline(always)]
-    fn enter(&self, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> [Option<f32>; 2] {
-        self.enter_portable(origin, inv_dir, t_max)
-    }
-
-    /// [`Pair::enter`] one box and one slab at a time.
-    #[cfg_attr(target_arch = "x86_64", allow(dead_code))]
-    #[inline(always)]
-    fn enter_portable(
-        &self,
-        origin: &[f32; 3],
-        inv_dir: &[f32; 3],
-        t_max: f32,
-    ) -> [Option<f32>; 2] {
-        let widen = far_widen();
-        let mut t0 = [0.0f32; 2];
-        let mut t1 = [t_max; 2];
-        for axis in 0..3 {
-            let s = &self.slabs[axis];
-            let t: [f32; 4] = std::array::from_fn(|j| (s[j] - origin[axis]) * inv_dir[axis]);
-            for c in 0..2 {
-                let (a, b) = (t[c], t[c + 2]);
-                let (near, far) = if a > b { (b, a) } else { (a, b) };
-                let far = far * widen;
-                if near > t0[c] {
-                    t0[c] = near;
-                }
-                if far < t1[c] {
-                    t1[c] = far;
-                }
-            }
-        }
-        [0, 1].map(|c| (t0[c] <= t1[c]).then_some(t0[c]))
-    }
-
-    /// The slab test above with SSE2 (part of every x86-64), both boxes' two slabs along an
-    /// axis in one register: the same `f32` operations, and SSE's min/max pick the same operand
-    /// as the portable form's comparisons, NaN included (`minps(x, y)` is `x < y ? x : y`).
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    fn enter(&self, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> [Option<f32>; 2] {
-        use std::arch::x86_64::*;
-        // SAFETY: SSE2 is baseline on x86-64; the loads read `[f32; 4]` arrays in full.
-        unsafe {
-            let widen = _mm_set1_ps(far_widen());
-            let mut t0 = _mm_setzero_ps();
-            let mut t1 = _mm_set1_ps(t_max);
-            for axis in 0..3 {
-                let s = _mm_loadu_ps(self.slabs[axis].as_ptr());
-                // Lanes: min 0, min 1, max 0, max 1.
-                let t = _mm_mul_ps(
-                    _mm_sub_ps(s, _mm_set1_ps(origin[axis])),
-                    _mm_set1_ps(inv_dir[axis]),
-                );
-                let a = t;
-                let b = _mm_movehl_ps(t, t);
-                // near = a > b ? b : a; far = a > b ? a : b.
-                let near = _mm_min_ps(b, a);
-                let far = _mm_mul_ps(_mm_max_ps(a, b), widen);
-                // t0 = near > t0 ? near : t0; t1 = far < t1 ? far : t1.
-                t0 = _mm_max_ps(near, t0);
-                t1 = _mm_min_ps(far, t1);
-            }
-            let hit = _mm_movemask_ps(_mm_cmple_ps(t0, t1));
-            let mut t = [0f32; 4];
-            _mm_storeu_ps(t.as_mut_ptr(), t0);
-            [
-                (hit & 1 != 0).then_some(t[0]),
-                (hit & 2 != 0).then_some(t[1]),
-            ]
-        }
-    }
-}
-
 /// A bounding volume hierarchy over a list of triangles.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Bvh {
     /// Sibling pairs in depth-first order; the root alone in the first. Node `i` is lane
     /// `i % 2` of pair `i / 2`.
     nodes: Vec<Pair>,
-    /// Vertices in leaf order.
-    vertices: Vec<[Vec3; 3]>,
-    /// Scene index of each entry of `vertices`.
+    /// Each leaf's triangles in [`Tri4`] blocks (the last one padded), leaves in depth-first
+    /// order; a leaf's [`Node::offset`] is its first block.
+    blocks: Vec<Tri4>,
+    /// Scene index of each lane of `blocks` (`u32::MAX` for padding).
     ids: Vec<u32>,
     depth: u32,
 }
@@ -214,15 +64,31 @@ impl Bvh {
             "a BVH holds at most 2³² − 1 triangles"
         );
         let built = build::build(triangles);
-        let vertices = built
-            .order
-            .par_iter()
-            .map(|&i| triangles[i as usize].v)
-            .collect();
+        let mut nodes: Vec<Pair> = built.pairs.into_par_iter().map(Pair::new).collect();
+        let leaves = |p: &Pair| (0..2).filter(|&l| p.count[l] > 0).count();
+        let n_blocks: usize = nodes
+            .iter()
+            .flat_map(|p| (0..2).map(|l| (p.count[l] as usize).div_ceil(LANES)))
+            .sum();
+        let mut blocks = Vec::with_capacity(n_blocks);
+        let mut ids = Vec::with_capacity(n_blocks * LANES);
+        for p in nodes.iter_mut().filter(|p| leaves(p) > 0) {
+            for lane in 0..2 {
+                let (offset, count) = (p.offset[lane] as usize, p.count[lane] as usize);
+                if count == 0 {
+                    continue;
+                }
+                let leaf = &built.order[offset..offset + count];
+                p.offset[lane] = u32::try_from(blocks.len()).expect("fewer than 2³² blocks");
+                blocks.extend(Tri4::pack(leaf.iter().map(|&i| triangles[i as usize].v)));
+                ids.extend_from_slice(leaf);
+                ids.resize(blocks.len() * LANES, u32::MAX);
+            }
+        }
         Bvh {
-            nodes: built.pairs.into_par_iter().map(Pair::new).collect(),
-            vertices,
-            ids: built.order,
+            nodes,
+            blocks,
+            ids,
             depth: built.depth,
         }
     }
@@ -275,14 +141,62 @@ impl Bvh {
         self.all_nodes().filter(|n| n.is_leaf()).count()
     }
 
-    /// The closest hit with `t < t_max` (ties go to the lowest scene index), or `None`.
+    /// The closest hit with `t < t_max` (ties go to the lowest scene index), or `None`, on
+    /// the widest SIMD path this CPU has.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        self.intersect_on(Isa::detect(), ray, t_max)
+    }
+
+    /// Whether some triangle has a hit with `t < t_max` (stops at the first found), on the
+    /// widest SIMD path this CPU has.
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        self.occluded_on(Isa::detect(), ray, t_max)
+    }
+
+    /// [`Bvh::intersect`] on path `isa`, which must be available.
+    pub fn intersect_on(&self, isa: Isa, ray: &Ray, t_max: f32) -> Option<Hit> {
+        assert!(isa.available(), "{} is not available", isa.name());
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: checked available above.
+            Isa::Avx2 => unsafe { closest_avx2(self, ray, t_max) },
+            #[cfg(target_arch = "x86_64")]
+            Isa::Sse2 => self.closest::<Sse2>(ray, t_max),
+            _ => self.closest::<Portable>(ray, t_max),
+        }
+    }
+
+    /// [`Bvh::occluded`] on path `isa`, which must be available.
+    pub fn occluded_on(&self, isa: Isa, ray: &Ray, t_max: f32) -> bool {
+        assert!(isa.available(), "{} is not available", isa.name());
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: checked available above.
+            Isa::Avx2 => unsafe { occluded_avx2(self, ray, t_max) },
+            #[cfg(target_arch = "x86_64")]
+            Isa::Sse2 => self.any::<Sse2>(ray, t_max),
+            _ => self.any::<Portable>(ray, t_max),
+        }
+    }
+
+    /// A leaf's blocks and their lanes' scene indices.
+    #[inline(always)]
+    fn leaf(&self, offset: usize, count: usize) -> (&[Tri4], &[u32]) {
+        let end = offset + count.div_ceil(LANES);
+        (
+            &self.blocks[offset..end],
+            &self.ids[offset * LANES..end * LANES],
+        )
+    }
+
+    #[inline(always)]
+    fn closest<K: Kernel>(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let root = self.nodes.first()?;
         let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
         let mut bound = cull_bound(t_max);
         root.enter(&o, &inv, bound)[0]?;
-        let mut best: Option<Hit> = None;
-        let mut tri_t_max = t_max;
+        let r = RayLanes::new(ray);
+        let mut c = Closest::new(t_max);
         let mut stack = [(0u32, 0f32); MAX_DEPTH];
         let mut sp = 0;
         let mut i = 0usize;
@@ -290,20 +204,10 @@ impl Bvh {
             let (pair, lane) = (&self.nodes[i >> 1], i & 1);
             let (offset, count) = (pair.offset[lane] as usize, pair.count[lane] as usize);
             if count > 0 {
-                for k in offset..offset + count {
-                    let Some(h) = intersect_watertight(ray, &self.vertices[k], tri_t_max) else {
-                        continue;
-                    };
-                    let id = self.ids[k];
-                    if best.is_none_or(|b| h.t < b.t || h.t == b.t && id < b.triangle) {
-                        best = Some(Hit {
-                            t: h.t,
-                            b: h.b,
-                            triangle: id,
-                        });
-                        tri_t_max = shrunk_t_max(h.t, t_max);
-                        bound = cull_bound(h.t);
-                    }
+                let (blocks, ids) = self.leaf(offset, count);
+                blocks_closest::<K>(blocks, ids, ray, &r, &mut c);
+                if let Some(h) = c.best {
+                    bound = cull_bound(h.t);
                 }
             } else {
                 let (a, b) = (offset, offset + 1);
@@ -331,7 +235,7 @@ impl Bvh {
             // Pop the next node the ray can still reach before the best hit.
             loop {
                 if sp == 0 {
-                    return best;
+                    return c.best;
                 }
                 sp -= 1;
                 let (n, t_enter) = stack[sp];
@@ -343,12 +247,13 @@ impl Bvh {
         }
     }
 
-    /// Whether some triangle has a hit with `t < t_max` (stops at the first found).
-    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+    #[inline(always)]
+    fn any<K: Kernel>(&self, ray: &Ray, t_max: f32) -> bool {
         let Some(root) = self.nodes.first() else {
             return false;
         };
         let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
+        let r = RayLanes::new(ray);
         let bound = cull_bound(t_max);
         if root.enter(&o, &inv, bound)[0].is_none() {
             return false;
@@ -360,10 +265,7 @@ impl Bvh {
             let (pair, lane) = (&self.nodes[i >> 1], i & 1);
             let (offset, count) = (pair.offset[lane] as usize, pair.count[lane] as usize);
             if count > 0 {
-                if self.vertices[offset..offset + count]
-                    .iter()
-                    .any(|v| intersect_watertight(ray, v, t_max).is_some())
-                {
+                if blocks_occluded::<K>(self.leaf(offset, count).0, ray, &r, t_max) {
                     return true;
                 }
             } else {
@@ -392,93 +294,26 @@ impl Bvh {
     }
 }
 
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn closest_avx2(bvh: &Bvh, ray: &Ray, t_max: f32) -> Option<Hit> {
+    bvh.closest::<Avx2>(ray, t_max)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn occluded_avx2(bvh: &Bvh, ray: &Ray, t_max: f32) -> bool {
+    bvh.any::<Avx2>(ray, t_max)
+}
+
 #[cfg(test)]
 mod tests {
-    use super::*;
-    use crate::geometry::Aabb;
+    use crate::accel::shrunk_t_max;
 
     #[test]
     fn shrunk_t_max_is_above_best_and_capped() {
         assert!(shrunk_t_max(1.0, f32::INFINITY) > 1.0);
         assert_eq!(shrunk_t_max(1.0, 1.0), 1.0);
         assert!(shrunk_t_max(1.0, 2.0) < 1.0 + 1e-6);
-    }
-
-    #[test]
-    fn every_slab_test_agrees_bit_for_bit() {
-        // Random boxes and rays, with axis-parallel rays and origins on slab planes mixed in
-        // (the NaN cases), compared bit for bit.
-        let mut rng = crate::rng::Rng::seeded(5);
-        let mut f = |scale: f32| (rng.next_f32() * 2.0 - 1.0) * scale;
-        for i in 0..20_000 {
-            let lo = [0, 1].map(|_| Vec3::new(f(1.0), f(1.0), f(1.0)));
-            let hi = lo.map(|l| l + Vec3::new(f(1.0).abs(), f(1.0).abs(), f(1.0).abs()));
-            let node = |k: usize| Node {
-                min: lo[k],
-                offset: 0,
-                max: hi[k],
-                count: 1,
-            };
-            let pair = Pair::new(NodePair([node(0), node(1)]));
-            let mut origin = Vec3::new(f(2.0), f(2.0), f(2.0));
-            let mut dir = Vec3::new(f(1.0), f(1.0), f(1.0));
-            if i % 3 == 0 {
-                dir[i % 9 / 3] = 0.0;
-                origin[i % 9 / 3] = if i % 2 == 0 {
-                    lo[0][i % 9 / 3]
-                } else {
-                    hi[1][i % 9 / 3]
-                };
-            }
-            if dir == Vec3::ZERO {
-                continue;
-            }
-            let ray = Ray::new(origin, dir);
-            let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
-            for t_max in [f32::INFINITY, f(3.0).abs()] {
-                let a = pair.enter(&o, &inv, t_max).map(|t| t.map(f32::to_bits));
-                let b = pair
-                    .enter_portable(&o, &inv, t_max)
-                    .map(|t| t.map(f32::to_bits));
-                assert_eq!(a, b, "{ray:?} {t_max} {pair:?}");
-                // Both are held to the one slab test, `Aabb::enter`.
-                let c = [0, 1].map(|k| {
-                    Aabb {
-                        min: lo[k],
-                        max: hi[k],
-                    }
-                    .enter(&ray, t_max)
-                    .map(f32::to_bits)
-                });
-                assert_eq!(a, c, "{ray:?} {t_max} {pair:?}");
-            }
-        }
-    }
-
-    #[test]
-    fn nan_slab_distances_keep_the_box() {
-        let node = Node {
-            min: Vec3::new(0.0, -1.0, 1.0),
-            offset: 0,
-            max: Vec3::new(1.0, 1.0, 2.0),
-            count: 1,
-        };
-        // Both lanes hold the box: they must agree.
-        let pair = Pair::new(NodePair([node; 2]));
-        assert_eq!(pair.node(1), node);
-        let node = |o: Vec3, inv: Vec3, t_max| {
-            let [a, b] = pair.enter(&o.to_array(), &inv.to_array(), t_max);
-            assert_eq!(a, b);
-            a
-        };
-        // Origin on the x = 0 face, ray along +z: (0 − 0)·∞ is NaN.
-        let ray = Ray::new(Vec3::ZERO, Vec3::Z);
-        assert_eq!(node(ray.origin, ray.inv_dir, f32::INFINITY), Some(1.0));
-        // Beside the box and parallel to its faces: missed.
-        let ray = Ray::new(Vec3::new(-0.5, 0.0, 0.0), Vec3::Z);
-        assert_eq!(node(ray.origin, ray.inv_dir, f32::INFINITY), None);
-        // Beyond t_max: missed.
-        let ray = Ray::new(Vec3::new(0.5, 0.0, 0.0), Vec3::Z);
-        assert_eq!(node(ray.origin, ray.inv_dir, 0.5), None);
     }
 }

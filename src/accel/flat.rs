@@ -1,53 +1,209 @@
-//! The flat object list: every object's box, then its triangles. Fastest below
-//! [`super::BVH_THRESHOLD`] triangles (the Cornell box).
+//! The flat object list, fastest below [`super::BVH_THRESHOLD`] triangles (the Cornell box):
+//! each object's triangles in [`Tri4`] blocks, the objects' boxes four
+//! to a [`Box4`]. A closest-hit query slab-tests every box four at a time, then visits the
+//! objects it meets nearest entry first, testing their blocks with the SIMD kernels, and stops
+//! once the next object starts beyond the best hit ([`cull_bound`]). An any-hit query stops at
+//! the first confirmed hit.
 
 use std::ops::Range;
 
-use super::hit::{Hit, cull_bound, shrunk_t_max};
-use crate::geometry::{Aabb, Ray, Triangle, intersect_watertight};
+use super::box4::Box4;
+use super::hit::{Hit, cull_bound};
+use super::isa::Isa;
+use super::tri4::{
+    Closest, Kernel, LANES, Portable, RayLanes, Tri4, blocks_closest, blocks_occluded,
+};
+use crate::geometry::{Aabb, Ray, Triangle};
 
-pub(super) fn flat_intersect(
-    objects: &[(Aabb, Range<usize>)],
-    triangles: &[Triangle],
-    ray: &Ray,
-    t_max: f32,
-) -> Option<Hit> {
-    let mut best: Option<Hit> = None;
-    let mut tri_t_max = t_max;
-    let mut bound = cull_bound(t_max);
-    for (aabb, range) in objects {
-        if !aabb.hit(ray, bound) {
-            continue;
+/// Objects sorted by entry distance on the stack; a list with more is visited in order.
+const SORTED_MAX: usize = 64;
+
+/// One object: its blocks.
+#[derive(Clone, Debug, PartialEq)]
+struct Object {
+    first: u32,
+    blocks: u32,
+}
+
+/// The flat list.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Flat {
+    boxes: Vec<Box4>,
+    objects: Vec<Object>,
+    blocks: Vec<Tri4>,
+    /// Scene index of each lane of `blocks` (`u32::MAX` for padding).
+    ids: Vec<u32>,
+}
+
+impl Flat {
+    /// The list of `objects` (contiguous ranges of `triangles`; empty ones are dropped).
+    pub fn build(triangles: &[Triangle], objects: &[Range<usize>]) -> Flat {
+        let mut f = Flat {
+            boxes: vec![],
+            objects: vec![],
+            blocks: vec![],
+            ids: vec![],
+        };
+        let mut aabbs = vec![];
+        for g in objects.iter().filter(|r| !r.is_empty()) {
+            let tris = &triangles[g.clone()];
+            let first = f.blocks.len();
+            f.blocks.extend(Tri4::pack(tris.iter().map(|t| t.v)));
+            let n = f.blocks.len() - first;
+            f.ids.extend(g.clone().map(|i| i as u32));
+            f.ids.resize((first + n) * LANES, u32::MAX);
+            f.objects.push(Object {
+                first: first as u32,
+                blocks: n as u32,
+            });
+            aabbs.push(
+                tris.iter()
+                    .fold(Aabb::EMPTY, |b, t| b.union(Aabb::of_triangle(t))),
+            );
         }
-        for i in range.clone() {
-            let Some(h) = intersect_watertight(ray, &triangles[i].v, tri_t_max) else {
-                continue;
-            };
-            if best.is_none_or(|b| h.t < b.t || h.t == b.t && (i as u32) < b.triangle) {
-                best = Some(Hit {
-                    t: h.t,
-                    b: h.b,
-                    triangle: i as u32,
-                });
-                tri_t_max = shrunk_t_max(h.t, t_max);
-                bound = cull_bound(h.t);
+        f.boxes = aabbs.chunks(4).map(Box4::new).collect();
+        f
+    }
+
+    /// The lanes of box group `g` that hold an object.
+    #[inline(always)]
+    fn lanes(&self, g: usize) -> u32 {
+        let n = (self.objects.len() - 4 * g).min(4);
+        (1 << n) - 1
+    }
+
+    /// Number of objects.
+    pub fn objects(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Closest hit on path `isa` (must be available).
+    pub fn intersect(&self, isa: Isa, ray: &Ray, t_max: f32) -> Option<Hit> {
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the caller passes an available path.
+            Isa::Avx2 => unsafe { closest_avx2(self, ray, t_max) },
+            #[cfg(target_arch = "x86_64")]
+            Isa::Sse2 => closest::<super::tri4::Sse2>(self, ray, t_max),
+            _ => closest::<Portable>(self, ray, t_max),
+        }
+    }
+
+    /// Any hit on path `isa` (must be available).
+    pub fn occluded(&self, isa: Isa, ray: &Ray, t_max: f32) -> bool {
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the caller passes an available path.
+            Isa::Avx2 => unsafe { occluded_avx2(self, ray, t_max) },
+            #[cfg(target_arch = "x86_64")]
+            Isa::Sse2 => occluded::<super::tri4::Sse2>(self, ray, t_max),
+            _ => occluded::<Portable>(self, ray, t_max),
+        }
+    }
+
+    /// The closest hit among object `o`'s triangles, folded into `c`.
+    #[inline(always)]
+    fn object_closest<K: Kernel>(&self, o: usize, ray: &Ray, r: &RayLanes, c: &mut Closest) {
+        let obj = &self.objects[o];
+        let (b, end) = (obj.first as usize, (obj.first + obj.blocks) as usize);
+        blocks_closest::<K>(
+            &self.blocks[b..end],
+            &self.ids[b * LANES..end * LANES],
+            ray,
+            r,
+            c,
+        );
+    }
+
+    /// Whether one of object `o`'s triangles has a hit before `t_max`.
+    #[inline(always)]
+    fn object_occluded<K: Kernel>(&self, o: usize, ray: &Ray, r: &RayLanes, t_max: f32) -> bool {
+        let obj = &self.objects[o];
+        let (b, end) = (obj.first as usize, (obj.first + obj.blocks) as usize);
+        blocks_occluded::<K>(&self.blocks[b..end], ray, r, t_max)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn closest_avx2(f: &Flat, ray: &Ray, t_max: f32) -> Option<Hit> {
+    closest::<super::tri4::Avx2>(f, ray, t_max)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn occluded_avx2(f: &Flat, ray: &Ray, t_max: f32) -> bool {
+    occluded::<super::tri4::Avx2>(f, ray, t_max)
+}
+
+#[inline(always)]
+fn closest<K: Kernel>(f: &Flat, ray: &Ray, t_max: f32) -> Option<Hit> {
+    let r = RayLanes::new(ray);
+    let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
+    let mut c = Closest::new(t_max);
+    let mut bound = cull_bound(t_max);
+    if f.objects.len() > SORTED_MAX {
+        for (g, bx) in f.boxes.iter().enumerate() {
+            let (mut mask, t) = K::boxes(bx, &o, &inv, bound);
+            mask &= f.lanes(g);
+            while mask != 0 {
+                let l = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if t[l] <= bound {
+                    f.object_closest::<K>(4 * g + l, ray, &r, &mut c);
+                    if let Some(h) = c.best {
+                        bound = cull_bound(h.t);
+                    }
+                }
+            }
+        }
+        return c.best;
+    }
+    // The objects the ray meets, by entry distance (insertion sort: a handful).
+    let mut order = [(0f32, 0u32); SORTED_MAX];
+    let mut n = 0;
+    for (g, bx) in f.boxes.iter().enumerate() {
+        let (mut mask, t) = K::boxes(bx, &o, &inv, bound);
+        mask &= f.lanes(g);
+        while mask != 0 {
+            let l = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let mut i = n;
+            while i > 0 && order[i - 1].0 > t[l] {
+                order[i] = order[i - 1];
+                i -= 1;
+            }
+            order[i] = (t[l], (4 * g + l) as u32);
+            n += 1;
+        }
+    }
+    for &(t_enter, obj) in &order[..n] {
+        if !(t_enter <= bound) {
+            break;
+        }
+        f.object_closest::<K>(obj as usize, ray, &r, &mut c);
+        if let Some(h) = c.best {
+            bound = cull_bound(h.t);
+        }
+    }
+    c.best
+}
+
+#[inline(always)]
+fn occluded<K: Kernel>(f: &Flat, ray: &Ray, t_max: f32) -> bool {
+    let r = RayLanes::new(ray);
+    let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
+    let bound = cull_bound(t_max);
+    for (g, bx) in f.boxes.iter().enumerate() {
+        let (mut mask, _) = K::boxes(bx, &o, &inv, bound);
+        mask &= f.lanes(g);
+        while mask != 0 {
+            let l = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            if f.object_occluded::<K>(4 * g + l, ray, &r, t_max) {
+                return true;
             }
         }
     }
-    best
-}
-
-pub(super) fn flat_occluded(
-    objects: &[(Aabb, Range<usize>)],
-    triangles: &[Triangle],
-    ray: &Ray,
-    t_max: f32,
-) -> bool {
-    let bound = cull_bound(t_max);
-    objects.iter().any(|(aabb, range)| {
-        aabb.hit(ray, bound)
-            && triangles[range.clone()]
-                .iter()
-                .any(|t| intersect_watertight(ray, &t.v, t_max).is_some())
-    })
+    false
 }

@@ -11,19 +11,26 @@
 //! smallest `t`, ties going to the lowest triangle index, and a shadow ray is occluded when any
 //! triangle has a hit before `t_max`. So a frame is byte-identical whichever is used (see
 //! [`crate::accel::bvh`] for how culling keeps to that).
+//!
+//! Both test triangles four or eight at a time ([`tri4`]) on the widest SIMD path the CPU has
+//! ([`Isa::detect`]); every path gives the same hits, bit for bit.
 
+pub mod box4;
 pub mod bvh;
 mod flat;
 mod hit;
+mod isa;
+pub mod tri4;
 
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
-use crate::geometry::{Aabb, Ray, Triangle};
+use crate::geometry::{Ray, Triangle};
 use bvh::Bvh;
-use flat::{flat_intersect, flat_occluded};
+use flat::Flat;
 
 pub use hit::{CULL_SLACK, Hit, cull_bound, shrunk_t_max};
+pub use isa::Isa;
 
 /// Scenes with at least this many triangles get a BVH; smaller ones the flat object list.
 ///
@@ -82,6 +89,8 @@ pub struct AccelStats {
 pub struct Accel {
     structure: Structure,
     stats: AccelStats,
+    /// The SIMD path queries take: always one the CPU has (checked where it is set).
+    isa: Isa,
 }
 
 /// Shows the structure but not its build time, so that two builds of one scene print the same.
@@ -89,13 +98,14 @@ impl std::fmt::Debug for Accel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Accel")
             .field("structure", &self.structure)
+            .field("isa", &self.isa)
             .finish_non_exhaustive()
     }
 }
 
 #[derive(Clone, Debug)]
 enum Structure {
-    Flat(Vec<(Aabb, Range<usize>)>),
+    Flat(Flat),
     Bvh(Bvh),
 }
 
@@ -120,23 +130,12 @@ impl Accel {
     pub fn build_kind(triangles: &[Triangle], objects: &[Range<usize>], kind: AccelKind) -> Accel {
         let start = Instant::now();
         let structure = match kind {
-            AccelKind::Flat => Structure::Flat(
-                objects
-                    .iter()
-                    .filter(|r| !r.is_empty())
-                    .map(|r| {
-                        let aabb = triangles[r.clone()]
-                            .iter()
-                            .fold(Aabb::EMPTY, |b, t| b.union(Aabb::of_triangle(t)));
-                        (aabb, r.clone())
-                    })
-                    .collect(),
-            ),
+            AccelKind::Flat => Structure::Flat(Flat::build(triangles, objects)),
             AccelKind::Bvh => Structure::Bvh(Bvh::build(triangles)),
         };
         let build = start.elapsed();
         let (nodes, depth) = match &structure {
-            Structure::Flat(objects) => (objects.len(), u32::from(!objects.is_empty())),
+            Structure::Flat(flat) => (flat.objects(), u32::from(flat.objects() > 0)),
             Structure::Bvh(bvh) => (bvh.nodes(), bvh.depth()),
         };
         Accel {
@@ -148,7 +147,20 @@ impl Accel {
                 depth,
                 build,
             },
+            isa: Isa::detect(),
         }
+    }
+
+    /// The SIMD path its queries take (by default the widest the CPU has).
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+
+    /// The same structure, queried on path `isa`; `None` if this CPU does not have it. Every
+    /// path gives the same hits.
+    pub fn with_isa(mut self, isa: Isa) -> Option<Accel> {
+        self.isa = isa.available().then_some(isa)?;
+        Some(self)
     }
 
     /// Its kind.
@@ -162,20 +174,19 @@ impl Accel {
     }
 
     /// The closest hit with `t < t_max` (ties go to the lowest triangle index), or `None`.
-    /// `triangles` must be the list the structure was built over.
     #[inline]
-    pub fn intersect(&self, triangles: &[Triangle], ray: &Ray, t_max: f32) -> Option<Hit> {
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         match &self.structure {
-            Structure::Flat(objects) => flat_intersect(objects, triangles, ray, t_max),
+            Structure::Flat(flat) => flat.intersect(self.isa, ray, t_max),
             Structure::Bvh(bvh) => bvh.intersect(ray, t_max),
         }
     }
 
     /// Whether any triangle has a hit with `t < t_max` (stops at the first).
     #[inline]
-    pub fn occluded(&self, triangles: &[Triangle], ray: &Ray, t_max: f32) -> bool {
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         match &self.structure {
-            Structure::Flat(objects) => flat_occluded(objects, triangles, ray, t_max),
+            Structure::Flat(flat) => flat.occluded(self.isa, ray, t_max),
             Structure::Bvh(bvh) => bvh.occluded(ray, t_max),
         }
     }

@@ -142,7 +142,13 @@ pub fn run_command(
         }
         writeln!(log, "raytty bench: {}", r.describe()).map_err(io_error("stderr"))?;
     }
-    let table = markdown(&report, &request.command);
+    let mut table = markdown(&report, &request.command);
+    if !request.csv {
+        table.push('\n');
+        table.push_str(&super::throughput::markdown(&throughputs(
+            scene, request, &options,
+        )));
+    }
     if request.csv {
         out.write_all(csv(&report).as_bytes())
     } else {
@@ -164,4 +170,21 @@ pub fn run_command(
         std::fs::write(path, new).map_err(io_error(format!("cannot write {}", path.display())))?;
     }
     Ok(())
+}
+
+/// The throughput section's measurements: `scene` at the first bench size, and (unless
+/// `--quick`) the built-in 1M-triangle sphere at the same size.
+fn throughputs(
+    scene: &Scene,
+    request: &BenchRequest,
+    options: &BenchOptions,
+) -> Vec<super::throughput::Throughput> {
+    let (w, h) = options.sizes.first().copied().unwrap_or((500, 500));
+    let mut out = vec![super::throughput::measure(scene, w, h, options.runs)];
+    if !request.quick
+        && let Some(Ok(sphere)) = crate::scene::builtin::find("sphere").map(|b| b.load())
+    {
+        out.push(super::throughput::measure(&sphere, w, h, options.runs));
+    }
+    out
 }

@@ -5,7 +5,8 @@
 
 use std::fmt::Write as _;
 
-use super::output::{GOAL_MS, GOAL_RMSE, series, sizes, tick};
+use super::output::{GOAL_MS, GOAL_RMSE, sizes};
+use super::svg::{series, tick};
 use super::{BenchReport, Row, RowKind};
 
 /// Plot area of one panel, in cells.

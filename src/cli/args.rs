@@ -164,6 +164,20 @@ pub(super) struct RenderArgs {
     /// Write to FILE instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub(super) output: Option<PathBuf>,
+    /// After the frame, print one line to stderr: render time in ms, samples per pixel, rays
+    /// by kind, M rays/s and the SIMD path; --stats=json prints it as one JSON object (keys ms,
+    /// spp, rays, mrays_per_s, simd, threads).
+    #[arg(long, value_name = "FORMAT", num_args = 0..=1, require_equals = true, default_missing_value = "text")]
+    pub(super) stats: Option<StatsFormat>,
+}
+
+/// How `render --stats` prints the frame's cost.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(super) enum StatsFormat {
+    /// One line for people.
+    Text,
+    /// One JSON object.
+    Json,
 }
 
 pub(super) fn parse_size(s: &str) -> Result<(u32, u32), String> {

@@ -43,11 +43,15 @@ pub fn main() -> ExitCode {
         Some(Command::Render(args)) => {
             run_render(&args, cli.scene.as_deref(), no_color).map(|()| ExitCode::SUCCESS)
         }
-        Some(Command::Scenes) => io::stdout()
-            .write_all(crate::cli::scene_arg::list().as_bytes())
-            .map(|()| ExitCode::SUCCESS)
-            .map_err(Into::into),
-        Some(Command::Bench(a)) => run_bench(a, cli.scene.as_deref()).map(|()| ExitCode::SUCCESS),
+        Some(Command::Scenes) => stdout_is_open("the list").and_then(|()| {
+            io::stdout()
+                .write_all(crate::cli::scene_arg::list().as_bytes())
+                .map(|()| ExitCode::SUCCESS)
+                .map_err(Into::into)
+        }),
+        Some(Command::Bench(a)) => stdout_is_open("the table")
+            .and_then(|()| run_bench(a, cli.scene.as_deref()))
+            .map(|()| ExitCode::SUCCESS),
         None => run_default(color, cli.scene.as_deref(), dumb),
     };
     match result {
@@ -81,6 +85,17 @@ fn app_status(outcome: crate::tui::Outcome) -> ExitCode {
         Outcome::Signal(sig) => ExitCode::from(signal_status(sig)),
         Outcome::Hangup => ExitCode::from(signal_status(libc::SIGHUP)),
     }
+}
+
+/// A failure if stdout was closed when raytty started (`>&-`): `what` would go nowhere.
+fn stdout_is_open(what: &str) -> Result<()> {
+    if render::stdout_was_closed() {
+        return Err(anyhow::anyhow!(
+            "stdout is closed: there is nowhere to write {what} (redirect it)"
+        )
+        .into());
+    }
+    Ok(())
 }
 
 /// `--scene` is a global flag, and clap checks a subcommand's `conflicts_with = "scene"` only
@@ -207,6 +222,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
             camera: None,
             light: None,
             output: None,
+            stats: None,
         },
         scene,
         false,

@@ -101,14 +101,22 @@ pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool)
             out.write_all(&encode_text(&CellGrid::from_image(&frame.image, mode)))
         }
     };
-    Ok(written.and_then(|()| out.flush()).with_context(|| {
+    written.and_then(|()| out.flush()).with_context(|| {
         format!(
             "cannot write to {}",
             args.output
                 .as_ref()
                 .map_or_else(|| "stdout".to_string(), |p| p.display().to_string())
         )
-    })?)
+    })?;
+    match args.stats {
+        Some(StatsFormat::Text) => {
+            eprintln!("raytty: {w}x{h}, {}", frame.stats.summary(scene.isa()))
+        }
+        Some(StatsFormat::Json) => eprintln!("{}", frame.stats.to_json(scene.isa())),
+        None => {}
+    }
+    Ok(())
 }
 
 /// Whether stdout was closed when raytty started (`raytty render >&-`), as opposed to a pipe

@@ -7,7 +7,7 @@
 //!   (background) or `█` (foreground);
 //! - one SGR sets the foreground and the background together, and only what changes.
 
-use super::{Cell, CellGrid, Colour, Pen, UPPER_HALF, WIDE_TAIL, write_char};
+use super::{Cell, CellGrid, Colour, Pen, UPPER_HALF, WIDE_TAIL, half_block, write_char};
 
 /// The lower-half block: its foreground paints the cell's lower pixel.
 pub const LOWER_HALF: char = '▄';
@@ -154,24 +154,35 @@ pub fn encode_diff_within(
             distance(&have[c], &want[c]) > limits.tolerance as u16
                 || (tail && have[c + 1] != want[c + 1])
         };
+        // What is sent for a cell: within a tolerance, a pixel takes a colour the pen holds
+        // if that is close enough, so that neighbours share colours and the pen carries over.
+        let send = |pen: Pen, c: usize| snap(&want[c], pen, limits.tolerance);
         let mut todo: Vec<usize> = (0..cols).filter(|&c| dirty(have, c)).collect();
         while !todo.is_empty() {
+            // Over the budget, only text is still sent (the status line, the help): image
+            // cells wait for the next frame, which begins with this row.
             if out.len() - start >= limits.max_bytes {
-                outcome = DiffOutcome {
-                    complete: false,
-                    next_row: r,
-                    max_error: UNLIKE,
-                };
-                break 'rows;
+                if outcome.complete {
+                    outcome = DiffOutcome {
+                        complete: false,
+                        next_row: r,
+                        max_error: UNLIKE,
+                    };
+                }
+                todo.retain(|&c| pixels(&want[c]).is_none());
+                if todo.is_empty() {
+                    continue 'rows;
+                }
             }
             // Of the next few cells of the row to send, the cheapest to reach and draw.
             let pick = (0..todo.len().min(ORDER_WINDOW))
-                .min_by_key(|&k| w.move_len(r, todo[k]) + w.draw_cost(&want[todo[k]]))
+                .min_by_key(|&k| w.move_len(r, todo[k]) + w.draw_cost(&send(w.pen, todo[k])))
                 .unwrap_or(0);
             let c = todo.remove(pick);
             w.move_to(out, r, c);
-            w.draw(out, &want[c], todo.first().map(|&n| &want[n]));
-            have[c] = want[c];
+            let cell = send(w.pen, c);
+            w.draw(out, &cell, todo.first().map(|&n| send(w.pen, n)).as_ref());
+            have[c] = cell;
             let wide = c + 1 < cols && want[c + 1].ch == WIDE_TAIL;
             if wide {
                 have[c + 1] = want[c + 1];
@@ -194,6 +205,32 @@ pub fn encode_diff_within(
         out.extend_from_slice(b"\x1b[0m");
     }
     outcome
+}
+
+/// `cell` with each pixel of a truecolor block cell replaced by the pen's foreground or
+/// background colour when that is within `tolerance` of it (0: `cell` as it is). A colour the
+/// pen holds costs no SGR, so an approximate frame costs a fraction of an exact one, and the
+/// pixels that are sent as they are need no second visit.
+fn snap(cell: &Cell, pen: Pen, tolerance: u8) -> Cell {
+    let near = |a: Colour, b: Option<Colour>| match (a, b) {
+        (Colour::Rgb(r0, g0, b0), Some(Colour::Rgb(r1, g1, b1))) => {
+            r0.abs_diff(r1).max(g0.abs_diff(g1)).max(b0.abs_diff(b1)) <= tolerance
+        }
+        _ => false,
+    };
+    let pick = |c: Colour| {
+        if near(c, pen.fg) {
+            pen.fg.unwrap_or(c)
+        } else if near(c, pen.bg) {
+            pen.bg.unwrap_or(c)
+        } else {
+            c
+        }
+    };
+    match pixels(cell) {
+        Some((up, lo)) if tolerance > 0 => half_block(pick(up), pick(lo)),
+        _ => *cell,
+    }
 }
 
 /// The encoder's belief about the terminal: the pen and, if known, the cursor.
@@ -349,7 +386,6 @@ fn relative(n: usize, f: char) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frame::half_block;
 
     /// What a cell shows: its two pixels for a block-drawing cell, else its character and
     /// colours (the foreground of a space is invisible).

@@ -14,7 +14,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::accel::{Accel, AccelKind, AccelStats, Hit};
+use crate::accel::{Accel, AccelKind, AccelStats, Hit, Isa};
 use crate::camera::Camera;
 use crate::geometry::{Aabb, DegenerateTriangle, Ray, Triangle};
 
@@ -319,20 +319,35 @@ impl Scene {
     /// The closest hit along `ray` with `t < t_max`.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        self.accel.intersect(&self.triangles, ray, t_max)
+        self.accel.intersect(ray, t_max)
     }
 
     /// Whether anything blocks `ray` before `t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.accel.occluded(&self.triangles, ray, t_max)
+        self.accel.occluded(ray, t_max)
     }
 
     /// The same scene with its acceleration structure rebuilt as `kind`. Frames do not change:
     /// every kind finds the same hits (see [`crate::accel`]).
     pub fn with_accel(mut self, kind: AccelKind) -> Scene {
-        self.accel = Accel::build_kind(&self.triangles, &self.objects, kind);
+        let isa = self.accel.isa();
+        self.accel = Accel::build_kind(&self.triangles, &self.objects, kind)
+            .with_isa(isa)
+            .expect("the scene's path is available");
         self
+    }
+
+    /// The same scene, its queries on SIMD path `isa`; `None` if this CPU does not have it.
+    /// Frames do not change: every path finds the same hits, bit for bit.
+    pub fn with_isa(mut self, isa: Isa) -> Option<Scene> {
+        self.accel = self.accel.with_isa(isa)?;
+        Some(self)
+    }
+
+    /// The SIMD path the scene's queries take.
+    pub fn isa(&self) -> Isa {
+        self.accel.isa()
     }
 
     /// A new acceleration structure of `kind` over this scene's triangles (for timing builds;

@@ -6,6 +6,7 @@
 pub mod app;
 pub mod input;
 pub mod keys;
+pub mod link;
 pub mod overlay;
 pub mod terminal;
 pub mod tty;

@@ -26,8 +26,9 @@ use signal_hook::iterator::Signals;
 use super::app::{App, Message, update};
 use super::input::{ESC_DELAY, KeyParser};
 use super::keys::message_for;
+use super::link::Link;
 use super::tty;
-use super::view::{GI_MAX_PASSES, Screen};
+use super::view::{GI_MAX_PASSES, LinkView, Screen};
 
 /// While refining, a new average is drawn at most this often: a few frames a second.
 const REFINE_DRAW_INTERVAL: Duration = Duration::from_millis(250);
@@ -37,6 +38,10 @@ const FORCED_EXIT_AFTER: Duration = Duration::from_secs(1);
 /// The writer checks this often whether its frame is still wanted while the terminal takes
 /// nothing (a stalled link).
 const WRITER_POLL: Duration = Duration::from_millis(100);
+
+/// The writer never waits longer than this for the queue to drain before taking the next
+/// frame, whatever the link model says (a wrong estimate must not stall the app).
+const MAX_PACING_WAIT: Duration = Duration::from_millis(250);
 
 /// How the app ended; the binary turns it into an exit status.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -58,8 +63,9 @@ enum Input {
     Hangup,
     /// A terminating signal.
     Signal(i32),
-    /// The writer is done with a frame (or could not write it).
-    Written(io::Result<()>),
+    /// The writer is done with a frame (or could not write it), and what it now knows of the
+    /// link.
+    Written(io::Result<LinkView>),
 }
 
 /// A frame for the writer, tagged with the terminal's epoch it was encoded for.
@@ -180,8 +186,18 @@ fn spawn_signal_thread(mut signals: Signals, tx: Sender<Input>) {
 fn spawn_writer_thread(tx: Sender<Input>) -> Sender<Job> {
     let (jobs, rx) = mpsc::channel::<Job>();
     std::thread::spawn(move || {
+        let mut link = Link::new(Instant::now());
         for job in rx {
-            let report = write_frame(&job);
+            let report = write_frame(&job, &mut link).map(|()| {
+                // Let the queue drain to its low-water mark before taking the next frame, so
+                // the next frame shows soon after it is encoded.
+                let wait = link.wait(Instant::now()).min(MAX_PACING_WAIT);
+                std::thread::sleep(wait);
+                LinkView {
+                    budget: link.budget(),
+                    rate: link.rate(),
+                }
+            });
             if tx.send(Input::Written(report)).is_err() {
                 return;
             }
@@ -190,24 +206,45 @@ fn spawn_writer_thread(tx: Sender<Input>) -> Sender<Job> {
     jobs
 }
 
-fn write_frame(job: &Job) -> io::Result<()> {
+/// Writes one frame, measuring the link as it goes (see [`Link`]).
+fn write_frame(job: &Job, link: &mut Link) -> io::Result<()> {
     let fd = tty::writer_fd();
     let mut rest = &job.bytes[..];
+    // When the queue was first found full, and the bytes taken since.
+    let mut full_since: Option<Instant> = None;
+    let mut drained = 0;
     while !rest.is_empty() && tty::writable_in(job.epoch) {
         match tty::write_some(fd, rest) {
-            Ok(n) => rest = &rest[n..],
+            Ok(n) => {
+                rest = &rest[n..];
+                link.wrote(n, Instant::now());
+                if full_since.is_some() {
+                    drained += n;
+                }
+            }
             Err(e) if e.kind() == io::ErrorKind::WouldBlock => {
+                if full_since.is_none() {
+                    full_since = Some(Instant::now());
+                    link.full(Instant::now());
+                }
                 tty::wait_writable(fd, WRITER_POLL);
             }
             Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
             Err(e) => return Err(e),
         }
     }
+    let now = Instant::now();
+    link.frame_done(drained, full_since.map(|t| now - t), now);
     Ok(())
 }
 
 /// Applies one input; returns the outcome if it ends the app.
-fn handle(app: &mut App, input: Input, busy: &mut bool) -> Result<Option<Outcome>> {
+fn handle(
+    app: &mut App,
+    screen: &mut Screen,
+    input: Input,
+    busy: &mut bool,
+) -> Result<Option<Outcome>> {
     match input {
         Input::Key(k) => {
             if let Some(m) = message_for(k) {
@@ -224,7 +261,7 @@ fn handle(app: &mut App, input: Input, busy: &mut bool) -> Result<Option<Outcome
         Input::Signal(s) => return Ok(Some(Outcome::Signal(s))),
         Input::Written(report) => {
             *busy = false;
-            report.context("cannot write to the terminal")?;
+            screen.link = report.context("cannot write to the terminal")?;
         }
     }
     Ok(None)
@@ -244,17 +281,18 @@ fn event_loop(mut app: App, rx: &Receiver<Input>, writer: &Sender<Job>) -> Resul
             let Ok(input) = rx.recv() else {
                 return Ok(Outcome::Hangup);
             };
-            if let Some(outcome) = handle(&mut app, input, &mut busy)? {
+            if let Some(outcome) = handle(&mut app, &mut screen, input, &mut busy)? {
                 return Ok(outcome);
             }
         }
         // Drain everything pending, so a held key never queues frames behind it.
         while let Ok(input) = rx.try_recv() {
-            if let Some(outcome) = handle(&mut app, input, &mut busy)? {
+            if let Some(outcome) = handle(&mut app, &mut screen, input, &mut busy)? {
                 return Ok(outcome);
             }
         }
-        if app.dirty {
+        // A changed app, or a screen the link's budget left approximate, needs a frame.
+        if app.dirty || screen.approximate() {
             stale = true;
             app.dirty = false;
         }

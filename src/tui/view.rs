@@ -7,12 +7,13 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use raytty::bench::timing::ms;
 use raytty::denoise::{Guides, denoise};
+use raytty::frame::{DiffLimits, UNLIKE, distance, encode_diff_within};
 use raytty::{
-    Camera, CellGrid, FrameStats, HitCache, Image, Stage, encode_diff, printable, render_cached,
-    render_guided,
+    Camera, CellGrid, FrameStats, HitCache, Image, Stage, printable, render_cached, render_guided,
 };
 
 use super::app::App;
+use super::link::describe;
 use super::overlay::{blank, draw_help, put_line, put_text, text_width};
 
 /// Smallest terminal drawn: below this a short message replaces the frame.
@@ -80,9 +81,32 @@ pub struct Screen {
     image: Image,
     /// What the terminal shows now.
     shown: Option<CellGrid>,
+    /// The row the next frame's diff begins with (after a frame the budget cut short).
+    next_row: usize,
+    /// The terminal shows an approximation of the latest frame: the next draw refines it.
+    approximate: bool,
     /// The last frame's costs.
     pub stats: DrawStats,
+    /// The link as the writer measures it: each frame is fitted to its budget.
+    pub link: LinkView,
 }
+
+/// What the view needs of the link: the next frame's byte budget and the rate to show.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LinkView {
+    /// Bytes the next frame may take (`None`: no limit, every frame exact).
+    pub budget: Option<usize>,
+    /// The measured drain rate in bytes per second, if measured.
+    pub rate: Option<f64>,
+}
+
+/// Tolerances tried for a frame over its budget, smallest first (levels per channel).
+const TOLERANCES: [u8; 5] = [0, 8, 16, 32, 64];
+/// What a sent cell costs on average, in bytes (truecolor, measured by `frame_bytes`: 20-25),
+/// to guess from a count of cells which tolerance fits a budget.
+const CELL_BYTES: usize = 24;
+/// The same for a cell sent within a tolerance, whose coarse colours often repeat.
+const COARSE_CELL_BYTES: usize = 10;
 
 /// The image size for a terminal of `cols × rows` cells, or `None` if it is too small.
 pub fn image_size(size: (u16, u16)) -> Option<(u32, u32)> {
@@ -104,7 +128,10 @@ impl Screen {
             error: (0.0, 0.0),
             image: Image::new(0, 0),
             shown: None,
+            next_row: 0,
+            approximate: false,
             stats: DrawStats::default(),
+            link: LinkView::default(),
         }
     }
 
@@ -211,8 +238,16 @@ impl Screen {
         self.shows_denoised = Some(app.denoise);
     }
 
+    /// Whether the terminal shows only an approximation of the latest frame (the link's budget
+    /// left some cells within a tolerance, or unsent): drawing again refines it.
+    pub fn approximate(&self) -> bool {
+        self.approximate
+    }
+
     /// The bytes that bring the terminal up to date (empty if nothing visible changed),
-    /// wrapped in synchronized output. Remembers what the terminal now shows.
+    /// wrapped in synchronized output, within the link's budget: cells that differ by at most
+    /// the smallest tolerance that fits are left for a later draw (see [`Screen::approximate`]).
+    /// Remembers what the terminal now shows.
     pub fn draw(&mut self, app: &App) -> Vec<u8> {
         let start = Instant::now();
         let (cols, rows) = (app.size.0 as usize, app.size.1 as usize);
@@ -227,16 +262,29 @@ impl Screen {
             let status = blank(cols, 1, app.color);
             g.rows += 1;
             g.cells.extend(status.cells);
-            put_line(&mut g, rows - 1, &self.status(app), app.color);
             if app.help {
                 draw_help(&mut g, app.color);
             }
             g
         };
+        let limits = match self.link.budget {
+            None => DiffLimits::EXACT,
+            Some(max_bytes) => DiffLimits {
+                tolerance: tolerance_for(self.shown.as_ref(), &grid, max_bytes),
+                max_bytes,
+                first_row: self.next_row,
+            },
+        };
+        let mut grid = grid;
+        if image_size(app.size) == Some((self.image.width, self.image.height)) {
+            self.approximate = limits.tolerance > 0;
+            put_line(&mut grid, rows - 1, &self.status(app), app.color);
+        }
         // Encoded straight after the begin marker: the frame is written into place, not copied.
         let mut out = SYNC_BEGIN.to_vec();
-        encode_diff(self.shown.as_ref(), &grid, 0, &mut out);
-        self.shown = Some(grid);
+        let outcome = encode_diff_within(&mut self.shown, &grid, 0, limits, &mut out);
+        self.next_row = outcome.next_row;
+        self.approximate = !outcome.complete || outcome.max_error > 0;
         if out.len() == SYNC_BEGIN.len() {
             return Vec::new();
         }
@@ -290,14 +338,58 @@ impl Screen {
             ),
             (format!("light {light}"), 5),
             (format!("render {:.1}ms", ms(self.stats.render.elapsed)), 3),
-            (format!("encode {:.1}ms", ms(self.stats.encode)), 8),
-            (format!("{}B", self.stats.bytes), 7),
+            (format!("encode {:.1}ms", ms(self.stats.encode)), 9),
+            (format!("{}B", self.stats.bytes), 8),
+            (format!("link {}", describe(self.link.rate)), 7),
+            (
+                if self.approximate {
+                    "approximate".into()
+                } else {
+                    String::new()
+                },
+                1,
+            ),
             (app.color.name().to_string(), 6),
             ("H:help".to_string(), 2),
         ];
         fields.retain(|(t, _)| !t.is_empty());
         fit_status(&fields, app.size.0 as usize)
     }
+}
+
+/// The smallest of [`TOLERANCES`] whose cells to send (those of `next` further than it from
+/// `shown`) fit in `max_bytes` at [`CELL_BYTES`] each, else the largest (the budget then cuts
+/// the frame short). Exact when the screen is unknown (a first frame or a new size).
+fn tolerance_for(shown: Option<&CellGrid>, next: &CellGrid, max_bytes: usize) -> u8 {
+    let Some(shown) = shown.filter(|s| s.cols == next.cols && s.rows == next.rows) else {
+        return 0;
+    };
+    // Image cells further than each tolerance (text is sent whatever the tolerance).
+    let mut beyond = [0usize; TOLERANCES.len()];
+    for (a, b) in shown.cells.iter().zip(&next.cells) {
+        let d = distance(a, b);
+        if d == UNLIKE {
+            continue;
+        }
+        for (n, &t) in beyond.iter_mut().zip(&TOLERANCES) {
+            *n += usize::from(d > u16::from(t));
+        }
+    }
+    let fits = |i: usize| {
+        let per_cell = if i == 0 {
+            CELL_BYTES
+        } else {
+            COARSE_CELL_BYTES
+        };
+        beyond[i] * per_cell <= max_bytes
+    };
+    let i = (0..TOLERANCES.len())
+        .find(|&i| fits(i))
+        .unwrap_or(TOLERANCES.len() - 1);
+    // Always progress: a tolerance that sends nothing while the screen is not exact gives way
+    // to the largest smaller one that sends something (the budget cuts it short).
+    let i = (0..=i).rev().find(|&j| beyond[j] > 0).unwrap_or(i);
+    TOLERANCES[i]
 }
 
 /// Joins `fields` (text, rank) into a status line of at most `width` columns where
@@ -309,7 +401,7 @@ fn fit_status(fields: &[(String, u8)], width: usize) -> String {
         let kept: Vec<&str> = fields
             .iter()
             .zip(keep)
-            .filter(|(_, k)| **k)
+            .filter(|((t, _), k)| **k && !t.is_empty())
             .map(|((t, _), _)| t.as_str())
             .collect();
         format!(" {}", kept.join("  "))
@@ -379,6 +471,36 @@ mod tests {
         update(&mut a, Message::Walk(0.1));
         s.render(&a);
         assert_eq!(s.stats.render.rays.primary, 40 * 24);
+    }
+
+    #[test]
+    fn over_a_budget_a_move_is_approximate_then_refines_to_exact() {
+        let mut a = app(60, 20);
+        let mut s = Screen::new();
+        s.render(&a);
+        s.draw(&a);
+        s.link = LinkView {
+            budget: Some(1500),
+            rate: Some(30_000.0),
+        };
+        update(&mut a, Message::MoveLight(Vec3::new(0.0, 0.0, 0.3)));
+        s.render(&a);
+        let first = s.draw(&a);
+        assert!(s.approximate(), "a move over budget is sent approximately");
+        assert!(first.len() < 1500 + 400, "{} bytes", first.len());
+        let mut draws = 0;
+        while s.approximate() {
+            let bytes = s.draw(&a);
+            assert!(
+                !bytes.is_empty(),
+                "an approximate screen always gets closer"
+            );
+            draws += 1;
+            assert!(draws < 100, "never exact");
+        }
+        let exact = CellGrid::from_image(&s.image, ColorMode::TrueColor);
+        let shown = s.shown.as_ref().unwrap();
+        assert_eq!(shown.cells[..exact.cells.len()], exact.cells[..]);
     }
 
     #[test]

@@ -23,6 +23,12 @@ pub const LEAF_MAX: usize = 8;
 /// Cost of visiting a node (two slab tests) relative to one triangle test, for the SAH.
 const TRAVERSAL_COST: f64 = 1.0;
 
+/// Cost of a leaf of `n` triangles, in triangle tests: the SIMD kernel tests a block of four
+/// for about the price of one scalar test (`tri4`), so a leaf costs its blocks.
+fn leaf_cost(n: usize) -> f64 {
+    n.div_ceil(4) as f64
+}
+
 /// Below this depth nodes split by SAH; deeper ones split at the median, which halves the count
 /// each level, so no tree is deeper than this plus log₂(2³²): within [`MAX_DEPTH`].
 const SAH_DEPTH: u32 = 30;
@@ -287,7 +293,7 @@ fn choose_split(refs: &[PrimRef], nb: &NodeBounds, depth: u32) -> Split {
     match (best, split) {
         (Some(cost), Some(split)) if cost.is_finite() && area.is_finite() && area > 0.0 => {
             let split_cost = TRAVERSAL_COST + cost / area;
-            if n <= LEAF_MAX && n as f64 <= split_cost {
+            if n <= LEAF_MAX && leaf_cost(n) <= split_cost {
                 Split::Leaf
             } else {
                 split

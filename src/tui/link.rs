@@ -1,0 +1,223 @@
+//! What the app knows of the link to the terminal, measured from inside: how fast the terminal
+//! side drains what we write, and how much is still queued. Pure (the caller passes the time),
+//! so the model is testable without a terminal.
+//!
+//! Writes go to a non-blocking descriptor. While the kernel's queue has room, a write takes
+//! everything at once and says nothing about the link; once it is full, a write takes only what
+//! the terminal has read meanwhile. So the bytes taken between the first "would block" of a
+//! frame and the frame's end, over that time, are the drain rate. From the rate:
+//! - the queue is modelled (bytes written, less rate × time), and the writer waits until it is
+//!   down to [`LOW_WATER`] of link time before it takes the next frame, so a frame reaches the
+//!   screen soon after it is encoded rather than behind a full queue;
+//! - each frame gets a byte budget of [`FRAME_TIME`] of link time.
+//!
+//! An unmeasured link (writes never blocked) counts as fast: no budget, exact frames. A rate
+//! that has not been re-measured for a while creeps up ([`PROBE_GROWTH`] per frame that went
+//! out without blocking), so a link that got faster is found again.
+
+use std::time::{Duration, Instant};
+
+/// Link time one frame may take: about fifteen frames a second. Longer frames get a fast
+/// link to exact sooner after a key is released; shorter ones show each step of a held key
+/// sooner on a slow one (65 ms was the best of 50, 65 and 80 in `examples/slow_link.rs`).
+pub const FRAME_TIME: Duration = Duration::from_millis(65);
+/// The writer takes the next frame once the queue is down to this much link time: enough to
+/// keep the link busy while the next frame is encoded, little enough that it shows soon.
+pub const LOW_WATER: Duration = Duration::from_millis(25);
+/// A drain-rate sample needs at least this much time with the queue full (shorter ones are
+/// dominated by scheduling noise and by the burst a link lets through after a pause).
+const MIN_SAMPLE: Duration = Duration::from_millis(30);
+/// Weight of a new rate sample against the estimate when it is lower: an overestimate fills
+/// the queue and delays every frame, so the estimate falls fast...
+const WEIGHT_DOWN: f64 = 0.5;
+/// ... and rises slowly (a short sample overestimates by the link's burst).
+const WEIGHT_UP: f64 = 0.25;
+/// The estimate grows by this factor for each frame that went out without blocking, back up
+/// to the rate a long sample measured ([`LONG_SAMPLE`]): an underestimate leaves the link
+/// idle...
+const RECOVER_GROWTH: f64 = 1.05;
+/// ... and past it by this factor (about 8 % a second at fifteen frames a second), so a link
+/// that got faster is found while an overestimate (which fills the queue and delays every
+/// frame) stays rare.
+const PROBE_GROWTH: f64 = 1.005;
+/// A sample over this long is not inflated by the burst a link lets through after a pause: the
+/// estimate recovers quickly up to the largest such sample.
+const LONG_SAMPLE: Duration = Duration::from_millis(100);
+/// The smallest frame budget: a status line and a few cells always fit.
+const MIN_BUDGET: usize = 512;
+
+/// The link model.
+#[derive(Clone, Copy, Debug)]
+pub struct Link {
+    /// Drain rate in bytes per second, once measured.
+    rate: Option<f64>,
+    /// Bytes queued at `at`, as modelled.
+    queued: f64,
+    at: Instant,
+    /// The queue when a write last blocked: the kernel's (and terminal's) buffer.
+    capacity: f64,
+    /// The largest sample taken over at least [`LONG_SAMPLE`].
+    ceiling: f64,
+}
+
+impl Link {
+    /// A link not measured yet.
+    pub fn new(now: Instant) -> Link {
+        Link {
+            rate: None,
+            queued: 0.0,
+            at: now,
+            capacity: 0.0,
+            ceiling: 0.0,
+        }
+    }
+
+    /// The measured drain rate in bytes per second, if any.
+    pub fn rate(&self) -> Option<f64> {
+        self.rate
+    }
+
+    /// Bytes believed still queued at `now` (0 on an unmeasured link).
+    pub fn queued(&self, now: Instant) -> f64 {
+        match self.rate {
+            Some(r) => {
+                (self.queued - r * now.saturating_duration_since(self.at).as_secs_f64()).max(0.0)
+            }
+            None => self.queued,
+        }
+    }
+
+    /// `n` bytes were written at `now`.
+    pub fn wrote(&mut self, n: usize, now: Instant) {
+        self.queued = self.queued(now) + n as f64;
+        self.at = now;
+    }
+
+    /// A write would have blocked at `now` for the first time in a frame: the queue is full,
+    /// and the model's queue is the best guess of how much it holds.
+    pub fn full(&mut self, now: Instant) {
+        self.capacity = self.queued(now);
+        self.at = now;
+    }
+
+    /// A frame is written: `drained` bytes were taken over `full_for` with the queue full (none
+    /// if it never blocked).
+    pub fn frame_done(&mut self, drained: usize, full_for: Option<Duration>, now: Instant) {
+        match full_for {
+            Some(t) if t >= MIN_SAMPLE && drained > 0 => {
+                let sample = drained as f64 / t.as_secs_f64();
+                if t >= LONG_SAMPLE {
+                    self.ceiling = self.ceiling.max(sample);
+                }
+                self.rate = Some(match self.rate {
+                    Some(r) if sample < r => r + WEIGHT_DOWN * (sample - r),
+                    Some(r) => r + WEIGHT_UP * (sample - r),
+                    None => sample,
+                });
+                self.queued = self.capacity;
+                self.at = now;
+            }
+            Some(_) => {
+                self.queued = self.capacity;
+                self.at = now;
+            }
+            None => {
+                if let Some(r) = self.rate.as_mut() {
+                    *r = if *r < self.ceiling {
+                        (*r * RECOVER_GROWTH).min(self.ceiling)
+                    } else {
+                        *r * PROBE_GROWTH
+                    };
+                }
+                if self.rate.is_none() {
+                    // Nothing can be known of an unmeasured queue: start afresh next frame.
+                    self.queued = 0.0;
+                }
+            }
+        }
+    }
+
+    /// How long after `now` the queue is down to [`LOW_WATER`] of link time.
+    pub fn wait(&self, now: Instant) -> Duration {
+        match self.rate {
+            Some(r) => {
+                let excess = self.queued(now) - r * LOW_WATER.as_secs_f64();
+                Duration::from_secs_f64((excess / r).max(0.0))
+            }
+            None => Duration::ZERO,
+        }
+    }
+
+    /// Bytes the next frame may take, or `None` for no limit (an unmeasured, fast link).
+    pub fn budget(&self) -> Option<usize> {
+        self.rate
+            .map(|r| ((r * FRAME_TIME.as_secs_f64()) as usize).max(MIN_BUDGET))
+    }
+}
+
+/// The rate as the status line shows it: `1.0Mbit/s`, `250kbit/s`; `fast` when unmeasured.
+pub fn describe(rate: Option<f64>) -> String {
+    match rate {
+        None => "fast".into(),
+        Some(r) => {
+            let bits = r * 8.0;
+            if bits >= 1e6 {
+                format!("{:.1}Mbit/s", bits / 1e6)
+            } else {
+                format!("{:.0}kbit/s", bits / 1e3)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MS: Duration = Duration::from_millis(1);
+
+    #[test]
+    fn an_unmeasured_link_is_fast_and_unlimited() {
+        let t = Instant::now();
+        let mut l = Link::new(t);
+        l.wrote(100_000, t);
+        l.frame_done(0, None, t + MS);
+        assert_eq!(
+            (l.budget(), l.wait(t + MS), describe(l.rate())),
+            (None, Duration::ZERO, "fast".into())
+        );
+    }
+
+    #[test]
+    fn a_blocked_frame_measures_the_rate_and_the_writer_waits_for_the_queue() {
+        let t = Instant::now();
+        let mut l = Link::new(t);
+        // 20 kB go in at once, then the queue is full; 125 kB drain over the next second.
+        l.wrote(20_000, t);
+        l.full(t);
+        l.wrote(125_000, t + 1000 * MS);
+        l.frame_done(125_000, Some(1000 * MS), t + 1000 * MS);
+        assert_eq!(l.rate(), Some(125_000.0));
+        assert_eq!(describe(l.rate()), "1.0Mbit/s");
+        assert_eq!(l.budget(), Some(8125));
+        // The queue is full (20 kB = 160 ms of link): the writer waits it down to 25 ms.
+        let wait = l.wait(t + 1000 * MS);
+        assert!((wait.as_secs_f64() - 0.135).abs() < 1e-3, "{wait:?}");
+        assert_eq!(l.wait(t + 1200 * MS), Duration::ZERO);
+        assert_eq!(l.queued(t + 1200 * MS), 0.0);
+    }
+
+    #[test]
+    fn frames_that_never_block_let_the_estimate_grow() {
+        let t = Instant::now();
+        let mut l = Link::new(t);
+        l.full(t);
+        l.frame_done(10_000, Some(100 * MS), t);
+        let before = l.budget().unwrap();
+        for _ in 0..200 {
+            l.frame_done(0, None, t);
+        }
+        assert!(l.budget().unwrap() > 2 * before);
+        assert_eq!(describe(Some(30_000.0)), "240kbit/s");
+    }
+}

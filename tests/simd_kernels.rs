@@ -1,0 +1,373 @@
+//! The SIMD paths (portable, SSE2, AVX2: each forced in turn) answer exactly as the scalar
+//! watertight test does: the same candidates with the same `t`, bit for bit, never dropping a
+//! triangle the scalar test hits; the same closest hit and any-hit answer from both structures;
+//! and the same frames. The rays are the stability suite's and the accel tests' kinds: through
+//! the shared edges and vertices of a jittered icosphere (also at a 1e5 offset), grazing and
+//! in-plane rays, random soups, and coordinates from 1e-15 to 2e38. A path this CPU lacks is
+//! skipped (and says so).
+
+mod common;
+
+use common::{Rng, in_cube, log_uniform, uniform, unit};
+use glam::Vec3;
+use raytty::accel::Isa;
+use raytty::accel::box4::Box4;
+use raytty::accel::tri4::{RayLanes, Tri4, candidates, candidates2};
+use raytty::geometry::{Aabb, intersect_watertight};
+use raytty::scene::procedural::displaced_icosphere;
+use raytty::{
+    AccelKind, Camera, Effects, Hit, Material, PointLight, Ray, Scene, SceneBuilder, Stage,
+    Triangle, cornell_box, render,
+};
+
+/// The paths this CPU runs (always the portable one and, on x86-64, SSE2).
+fn paths() -> Vec<Isa> {
+    let all: Vec<Isa> = Isa::ALL.into_iter().filter(|i| i.available()).collect();
+    for isa in Isa::ALL {
+        if !isa.available() {
+            eprintln!(
+                "note: this CPU has no {}; that path is not tested",
+                isa.name()
+            );
+        }
+    }
+    all
+}
+
+/// A triangle soup: `n` triangles of size `size` in a cube of half-side `half`, times `scale`.
+fn soup(seed: u64, n: usize, half: f32, size: f32, scale: f32) -> Vec<[Vec3; 3]> {
+    let mut rng = Rng::seeded(seed);
+    let mut out = Vec::with_capacity(n);
+    while out.len() < n {
+        let c = in_cube(&mut rng, half);
+        let v = [0; 3].map(|_| (c + in_cube(&mut rng, size)) * scale);
+        if Triangle::new(v[0], v[1], v[2], 0).is_ok() {
+            out.push(v);
+        }
+    }
+    out
+}
+
+/// Rays at the mesh's vertices and edge midpoints (ties between neighbours), random rays, and
+/// rays grazing or lying in a triangle's plane, each with `t_max` ∞ or a fraction of the way.
+fn rays(seed: u64, tris: &[[Vec3; 3]], n: usize, reach: f32, centre: Vec3) -> Vec<(Ray, f32)> {
+    let mut rng = Rng::seeded(seed);
+    (0..n)
+        .map(|i| {
+            let t = &tris[(rng.next_u64() % tris.len() as u64) as usize];
+            let k = (rng.next_u64() % 3) as usize;
+            let origin = centre + in_cube(&mut rng, reach);
+            let (origin, target) = match i % 5 {
+                0 => (origin, centre + in_cube(&mut rng, reach)),
+                1 => (origin, t[k]),
+                2 => (origin, t[k] * 0.5 + t[(k + 1) % 3] * 0.5),
+                // In the plane of the triangle, through its edge.
+                3 => {
+                    let a = t[k] * 0.5 + t[(k + 1) % 3] * 0.5;
+                    (a + (t[k] - t[(k + 2) % 3]) * uniform(&mut rng, 0.5, 3.0), a)
+                }
+                // Grazing: just off the plane, by an angle down to 1e-7 rad.
+                _ => {
+                    let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+                    let a = t[k] * 0.3 + t[(k + 1) % 3] * 0.3 + t[(k + 2) % 3] * 0.4;
+                    let along = (t[k] - a).normalize();
+                    let angle = log_uniform(&mut rng, -7.0, -2.0);
+                    let d = along + n * angle;
+                    (a - d * (t[k] - a).length() * 2.0, a)
+                }
+            };
+            let origin = if origin.is_finite() { origin } else { centre };
+            let mut dir = target - origin;
+            if dir == Vec3::ZERO || !dir.is_finite() {
+                dir = unit(&mut rng);
+            }
+            let t_max = if i % 4 == 0 {
+                uniform(&mut rng, 0.2, 1.5)
+            } else {
+                f32::INFINITY
+            };
+            (Ray::new(origin, dir), t_max)
+        })
+        .collect()
+}
+
+/// Every path's candidates for every block: identical masks and `t` bits on every path, a
+/// superset of the scalar test's hits, and each hit's `t` equal to the scalar one. Returns the
+/// number of scalar hits seen.
+fn assert_kernels_agree(tris: &[[Vec3; 3]], rays: &[(Ray, f32)], what: &str) -> usize {
+    let blocks = Tri4::pack(tris.iter().copied());
+    let paths = paths();
+    let mut hits = 0;
+    for (r, &(ray, t_max)) in rays.iter().enumerate() {
+        let lanes = RayLanes::new(&ray);
+        for (b, block) in blocks.iter().enumerate() {
+            let want = candidates(Isa::Portable, block, &lanes, t_max);
+            for &isa in &paths[1..] {
+                let got = candidates(isa, block, &lanes, t_max);
+                assert_eq!(
+                    got.mask, want.mask,
+                    "{what}: ray {r} {ray:?} block {b} on {isa:?}"
+                );
+                for l in 0..4 {
+                    if want.mask & 1 << l != 0 {
+                        assert_eq!(
+                            got.t[l].to_bits(),
+                            want.t[l].to_bits(),
+                            "{what}: ray {r} block {b} lane {l} on {isa:?}"
+                        );
+                    }
+                }
+            }
+            for l in 0..4 {
+                let i = b * 4 + l;
+                let Some(tri) = tris.get(i) else { continue };
+                if let Some(h) = intersect_watertight(&ray, tri, t_max) {
+                    hits += 1;
+                    assert!(
+                        want.mask & 1 << l != 0,
+                        "{what}: ray {r} {ray:?} hits triangle {i} {tri:?}, not a candidate"
+                    );
+                    let t = want.t[l];
+                    assert!(
+                        t == f32::NEG_INFINITY || t.to_bits() == h.t.to_bits(),
+                        "{what}: ray {r} triangle {i}: t {t} against {}",
+                        h.t
+                    );
+                }
+            }
+        }
+        // Two blocks at once (AVX2's eight lanes) give both blocks' candidates.
+        for pair in blocks.chunks(2).filter(|p| p.len() == 2) {
+            let one = [0, 1].map(|k| candidates(Isa::Portable, &pair[k], &lanes, t_max));
+            for &isa in &paths {
+                let two = candidates2(isa, &pair[0], &pair[1], &lanes, t_max);
+                assert_eq!(
+                    two.mask,
+                    one[0].mask | one[1].mask << 4,
+                    "{what}: ray {r} {isa:?}"
+                );
+                for l in 0..8 {
+                    if two.mask & 1 << l != 0 {
+                        assert_eq!(two.t[l].to_bits(), one[l / 4].t[l % 4].to_bits());
+                    }
+                }
+            }
+        }
+    }
+    hits
+}
+
+/// The answer by definition: the smallest `t`, ties to the lowest index.
+fn brute_force(tris: &[[Vec3; 3]], ray: &Ray, t_max: f32) -> Option<Hit> {
+    let mut best: Option<Hit> = None;
+    for (i, v) in tris.iter().enumerate() {
+        if let Some(h) = intersect_watertight(ray, v, t_max)
+            && best.is_none_or(|b| h.t < b.t)
+        {
+            best = Some(Hit {
+                t: h.t,
+                b: h.b,
+                triangle: i as u32,
+            });
+        }
+    }
+    best
+}
+
+fn scene_of(objects: &[Vec<[Vec3; 3]>], kind: AccelKind) -> Scene {
+    let mut b = SceneBuilder::new();
+    let m = b.material(Material::diffuse(Vec3::splat(0.7)));
+    for o in objects {
+        b.object(o.iter().copied(), m);
+    }
+    b.light(PointLight {
+        position: Vec3::new(0.3, -0.8, -0.5),
+        power: Vec3::splat(14.0),
+    });
+    b.accel(kind);
+    b.build("test", Camera::default(), Effects::SEED).unwrap()
+}
+
+/// Both structures on every path answer every query as the brute-force loop, bit for bit.
+fn assert_structures_agree(objects: &[Vec<[Vec3; 3]>], rays: &[(Ray, f32)], what: &str) {
+    let tris: Vec<[Vec3; 3]> = objects.concat();
+    for kind in [AccelKind::Flat, AccelKind::Bvh] {
+        let scene = scene_of(objects, kind);
+        for isa in paths() {
+            let s = scene.clone().with_isa(isa).expect("available");
+            assert_eq!(s.isa(), isa);
+            for (r, &(ray, t_max)) in rays.iter().enumerate() {
+                let want = brute_force(&tris, &ray, t_max);
+                let got = s.intersect(&ray, t_max);
+                assert_eq!(
+                    got.map(|h| (h.t.to_bits(), h.b.map(f32::to_bits), h.triangle)),
+                    want.map(|h| (h.t.to_bits(), h.b.map(f32::to_bits), h.triangle)),
+                    "{what}: ray {r} {ray:?} t_max {t_max}, {kind:?} on {isa:?}"
+                );
+                assert_eq!(
+                    s.occluded(&ray, t_max),
+                    want.is_some(),
+                    "{what}: ray {r} {ray:?} any-hit, {kind:?} on {isa:?}"
+                );
+            }
+        }
+    }
+}
+
+/// A jittered icosphere (shared vertices: rays through its edges and vertices tie) split into
+/// a few objects, around `centre`.
+fn icosphere(centre: Vec3) -> Vec<Vec<[Vec3; 3]>> {
+    let tris: Vec<[Vec3; 3]> = displaced_icosphere(4, 0.2)
+        .into_iter()
+        .map(|v| v.map(|p| p + centre))
+        .collect();
+    tris.chunks(50).map(<[_]>::to_vec).collect()
+}
+
+#[test]
+fn kernels_match_the_scalar_test_on_an_icosphere_through_edges_and_vertices() {
+    for centre in [Vec3::ZERO, Vec3::splat(1e5)] {
+        let tris = icosphere(centre).concat();
+        let rays = rays(1, &tris, 3_000, 0.7, centre);
+        let hits = assert_kernels_agree(&tris, &rays, &format!("icosphere at {centre}"));
+        assert!(hits > 2_000, "{hits} hits");
+    }
+}
+
+#[test]
+fn kernels_match_the_scalar_test_on_soups_from_1e_minus_15_to_2e38() {
+    for (seed, scale, reach) in [
+        (2, 1e-15, 1.5),
+        (3, 1e-6, 1.5),
+        (4, 1.0, 1.5),
+        (5, 1e6, 1.5),
+        (6, 1e15, 1.5),
+        (7, 1e30, 1.5),
+        (8, 2e38, 0.1),
+    ] {
+        let tris = soup(seed, 64, 1.0, 0.3, scale);
+        let rays = rays(seed, &tris, 1_500, reach * scale, Vec3::ZERO);
+        assert_kernels_agree(&tris, &rays, &format!("soup at scale {scale}"));
+    }
+}
+
+#[test]
+fn kernels_match_on_the_cornell_box_camera_and_shadow_rays() {
+    let scene = cornell_box();
+    let tris: Vec<[Vec3; 3]> = scene.triangles().iter().map(|t| t.v).collect();
+    let cam = scene.camera().rays(100, 100);
+    let light = scene.lights()[0].position;
+    let mut rays = vec![];
+    for y in 0..100 {
+        for x in 0..100 {
+            let ray = cam.ray(x as f32 + 0.5, y as f32 + 0.5);
+            rays.push((ray, f32::INFINITY));
+            if let Some(h) = scene.intersect(&ray, f32::INFINITY) {
+                let p = ray.at(h.t);
+                rays.push((Ray::new(p, light - p), 0.9999));
+            }
+        }
+    }
+    assert!(assert_kernels_agree(&tris, &rays, "cornell") > 10_000);
+}
+
+#[test]
+fn structures_on_every_path_match_brute_force() {
+    for centre in [Vec3::ZERO, Vec3::splat(1e5)] {
+        let objects = icosphere(centre);
+        let tris = objects.concat();
+        let rays = rays(11, &tris, 2_000, 0.7, centre);
+        assert_structures_agree(&objects, &rays, &format!("icosphere at {centre}"));
+    }
+    for (seed, scale) in [(12, 1e-15), (13, 1.0), (14, 1e30)] {
+        // Many small objects: more than the flat list sorts by entry distance.
+        let objects: Vec<Vec<[Vec3; 3]>> = soup(seed, 300, 1.0, 0.2, scale)
+            .chunks(3)
+            .map(<[_]>::to_vec)
+            .collect();
+        let tris = objects.concat();
+        let rays = rays(seed, &tris, 1_000, 1.5 * scale, Vec3::ZERO);
+        assert_structures_agree(&objects, &rays, &format!("soup at scale {scale}"));
+    }
+}
+
+#[test]
+fn cornell_frames_are_identical_on_every_path() {
+    let scene = cornell_box();
+    for stage in Stage::ALL {
+        let settings = stage.settings(scene.effects());
+        let frame = |s: &Scene| {
+            let f = render(s, &s.camera(), s.lights(), &settings, 96, 64);
+            let bits: Vec<u32> = f
+                .image
+                .pixels
+                .iter()
+                .flat_map(|p| p.to_array().map(f32::to_bits))
+                .collect();
+            (bits, f.stats.rays)
+        };
+        let want = frame(&scene.clone().with_isa(Isa::Portable).unwrap());
+        for isa in paths() {
+            for kind in [AccelKind::Flat, AccelKind::Bvh] {
+                let s = scene.clone().with_accel(kind).with_isa(isa).unwrap();
+                assert!(frame(&s) == want, "{stage:?} differs on {isa:?} {kind:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn box_tests_agree_on_every_path() {
+    // Random boxes and rays, with axis-parallel rays and origins on slab planes mixed in (the
+    // NaN cases), compared bit for bit with the portable form and with `Aabb::enter`.
+    let mut rng = Rng::seeded(5);
+    for i in 0..20_000 {
+        let boxes: Vec<Aabb> = (0..4)
+            .map(|_| {
+                let lo = in_cube(&mut rng, 1.0);
+                let size = in_cube(&mut rng, 1.0).abs();
+                Aabb {
+                    min: lo,
+                    max: lo + size,
+                }
+            })
+            .collect();
+        let b = Box4::new(&boxes);
+        let mut origin = in_cube(&mut rng, 2.0);
+        let mut dir = in_cube(&mut rng, 1.0);
+        if i % 3 == 0 {
+            let axis = i % 9 / 3;
+            dir[axis] = 0.0;
+            origin[axis] = if i % 2 == 0 {
+                boxes[0].min[axis]
+            } else {
+                boxes[1].max[axis]
+            };
+        }
+        if dir == Vec3::ZERO {
+            continue;
+        }
+        let ray = Ray::new(origin, dir);
+        let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
+        for t_max in [f32::INFINITY, uniform(&mut rng, 0.0, 3.0)] {
+            let (mask, t) = b.enter_portable(&o, &inv, t_max);
+            // Held to the one slab test, `Aabb::enter`: the same boxes, entered at the same t.
+            for (l, bx) in boxes.iter().enumerate() {
+                let want = bx.enter(&ray, t_max).map(f32::to_bits);
+                let got = (mask & 1 << l != 0).then_some(t[l].to_bits());
+                assert_eq!(got, want, "{ray:?} {bx:?} {t_max}");
+            }
+            #[cfg(target_arch = "x86_64")]
+            {
+                let (m2, t2) = b.enter_sse2(&o, &inv, t_max);
+                assert_eq!(m2, mask, "{ray:?} {t_max}");
+                for l in 0..4 {
+                    if mask & 1 << l != 0 {
+                        assert_eq!(t2[l].to_bits(), t[l].to_bits());
+                    }
+                }
+            }
+            let _ = t;
+        }
+    }
+}

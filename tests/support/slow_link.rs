@@ -1,0 +1,189 @@
+//! A link emulator: runs a program in a pseudo-terminal and reads what it writes no faster than
+//! a given rate, as a terminal at the far end of a slow SSH connection would receive it. What is
+//! read goes through a terminal emulator (vt100), so the screen can be judged as a user sees
+//! it. Shared by `tests/tui_pty.rs` and `examples/slow_link.rs` (the bench).
+#![allow(dead_code)]
+
+use std::io::{Read, Write};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system};
+use raytty::CellGrid;
+use raytty::frame::{Colour, pixels};
+
+/// The most the link lets through at once after an idle spell, in time at its rate (a real
+/// link's queue): long enough that the reader's own scheduling delays on a busy machine do not
+/// slow the link down.
+const BURST: Duration = Duration::from_millis(10);
+/// Longest read.
+const READ_MAX: usize = 65536;
+/// How often the reader wakes while waiting for the link's next bytes.
+const TICK: Duration = Duration::from_millis(1);
+
+/// What the far end has seen.
+pub struct Far {
+    /// The terminal the bytes were played into.
+    pub screen: vt100::Parser,
+    /// Bytes read so far.
+    pub bytes: usize,
+    /// The program closed the pty.
+    pub closed: bool,
+    /// When the last bytes were read.
+    pub last_read: Option<Instant>,
+}
+
+/// A program on the far side of a link of `rate` bytes per second.
+pub struct SlowLink {
+    pub child: Box<dyn Child + Send + Sync>,
+    master: Box<dyn MasterPty + Send>,
+    writer: Box<dyn Write + Send>,
+    pub far: Arc<Mutex<Far>>,
+}
+
+impl SlowLink {
+    /// Starts `program` with `args` in a `cols × rows` pty drained at `rate` bytes per second.
+    pub fn start(program: &str, args: &[&str], cols: u16, rows: u16, rate: f64) -> SlowLink {
+        let pair = native_pty_system()
+            .openpty(PtySize {
+                rows,
+                cols,
+                pixel_width: 0,
+                pixel_height: 0,
+            })
+            .expect("open a pty");
+        let mut cmd = CommandBuilder::new(program);
+        cmd.args(args);
+        cmd.env("TERM", "xterm-256color");
+        cmd.env_remove("NO_COLOR");
+        let child = pair.slave.spawn_command(cmd).expect("spawn the program");
+        drop(pair.slave);
+        let mut reader = pair.master.try_clone_reader().expect("pty reader");
+        let writer = pair.master.take_writer().expect("pty writer");
+        let far = Arc::new(Mutex::new(Far {
+            screen: vt100::Parser::new(
+                std::num::NonZeroU16::new(rows).expect("rows"),
+                std::num::NonZeroU16::new(cols).expect("columns"),
+                0,
+            ),
+            bytes: 0,
+            closed: false,
+            last_read: None,
+        }));
+        let shared = far.clone();
+        std::thread::spawn(move || {
+            let start = Instant::now();
+            let mut read = 0.0f64;
+            let mut buf = vec![0u8; READ_MAX];
+            loop {
+                // A token bucket: what the link has carried by now, less what was read, at most
+                // a burst.
+                let carried = rate * start.elapsed().as_secs_f64();
+                read = read.max(carried - rate * BURST.as_secs_f64());
+                let allowed = (carried - read).floor();
+                if allowed < 1.0 {
+                    std::thread::sleep(TICK);
+                    continue;
+                }
+                let want = (allowed as usize).min(READ_MAX);
+                let n = match reader.read(&mut buf[..want]) {
+                    Ok(0) | Err(_) => break,
+                    Ok(n) => n,
+                };
+                read += n as f64;
+                let now = Instant::now();
+                let mut far = shared.lock().expect("the far end");
+                far.screen.process(&buf[..n]);
+                far.bytes += n;
+                far.last_read = Some(now);
+            }
+            shared.lock().expect("the far end").closed = true;
+        });
+        SlowLink {
+            child,
+            master: pair.master,
+            writer,
+            far,
+        }
+    }
+
+    /// Types `bytes` (the link's upstream is not throttled: keys are small).
+    pub fn send(&mut self, bytes: &[u8]) {
+        self.writer.write_all(bytes).expect("write to the pty");
+        self.writer.flush().expect("flush the pty");
+    }
+
+    /// Waits until `cond` holds for the far end's screen, at most `limit`; whether it did.
+    /// The screen is copied out of the lock, so judging it never holds up the link.
+    pub fn wait_for(&self, limit: Duration, mut cond: impl FnMut(&vt100::Screen) -> bool) -> bool {
+        let deadline = Instant::now() + limit;
+        loop {
+            if cond(&self.snapshot().0) {
+                return true;
+            }
+            if Instant::now() > deadline {
+                return false;
+            }
+            std::thread::sleep(TICK);
+        }
+    }
+
+    /// A copy of the far end's screen, the bytes read and when the last were read.
+    pub fn snapshot(&self) -> (vt100::Screen, usize, Option<Instant>) {
+        let far = self.far.lock().expect("the far end");
+        (far.screen.screen().clone(), far.bytes, far.last_read)
+    }
+
+    /// The pty's master side (to resize it).
+    pub fn master(&self) -> &dyn MasterPty {
+        self.master.as_ref()
+    }
+}
+
+impl Drop for SlowLink {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// The two pixels a block-drawing cell shows (`▀`, `▄`, `█`, a space), if it is one.
+pub fn shown_pixels(screen: &vt100::Screen, r: u16, c: u16) -> Option<(Colour, Colour)> {
+    let cell = screen.cell(r, c)?;
+    let rgb = |c: vt100::Color| match c {
+        vt100::Color::Rgb(r, g, b) => Some(Colour::Rgb(r, g, b)),
+        _ => None,
+    };
+    let (fg, bg) = (rgb(cell.fgcolor()), rgb(cell.bgcolor()));
+    match cell.contents().chars().next().unwrap_or(' ') {
+        '▀' => Some((fg?, bg?)),
+        '▄' => Some((bg?, fg?)),
+        '█' => Some((fg?, fg?)),
+        ' ' => Some((bg?, bg?)),
+        _ => None,
+    }
+}
+
+/// The largest difference, in levels of one channel, between the screen's image rows and
+/// `want`'s pixels; 256 where a cell is not a block cell at all.
+pub fn max_error(screen: &vt100::Screen, want: &CellGrid) -> u16 {
+    let d = |a: Colour, b: Colour| match (a, b) {
+        (Colour::Rgb(r0, g0, b0), Colour::Rgb(r1, g1, b1)) => {
+            r0.abs_diff(r1).max(g0.abs_diff(g1)).max(b0.abs_diff(b1)) as u16
+        }
+        _ => 256,
+    };
+    let mut worst = 0;
+    for r in 0..want.rows {
+        for c in 0..want.cols {
+            let w = pixels(&want.get(c, r));
+            let got = shown_pixels(screen, r as u16, c as u16);
+            let e = match (w, got) {
+                (Some(w), Some(g)) => d(w.0, g.0).max(d(w.1, g.1)),
+                _ => 256,
+            };
+            worst = worst.max(e);
+        }
+    }
+    worst
+}
