@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use crate::accel::Hit;
 use crate::camera::Camera;
-use crate::denoise::{GuidePixel, Guides};
+use crate::denoise::{GuidePixel, Guides, denoise};
 use crate::image::Image;
 use crate::rng::Rng;
 use crate::scene::{PointLight, Scene};
@@ -311,4 +311,32 @@ impl FrameStats {
             rayon::current_num_threads()
         )
     }
+}
+
+/// Renders a frame and, if its indirect light is path traced, denoises it: the frame's image
+/// is the denoised one and its time includes the filter's. Other frames are as
+/// [`render`] gives them.
+pub fn render_denoised(
+    scene: &Scene,
+    camera: &Camera,
+    lights: &[PointLight],
+    settings: &Settings,
+    width: u32,
+    height: u32,
+) -> Frame {
+    let mut frame = render_guided(
+        scene,
+        camera,
+        lights,
+        settings,
+        width,
+        height,
+        &mut HitCache::new(),
+    );
+    if let Some(g) = &frame.guides {
+        let start = Instant::now();
+        frame.image = denoise(g).image;
+        frame.stats.elapsed += start.elapsed();
+    }
+    frame
 }

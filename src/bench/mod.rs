@@ -22,10 +22,10 @@ use std::io;
 use std::path::PathBuf;
 use std::time::Duration;
 
-use crate::denoise::render_denoised;
 use crate::frame::{CellGrid, ColorMode, encode_text};
 use crate::image::Image;
 use crate::render::render;
+use crate::render::render_denoised;
 use crate::scene::{Effects, Indirect, Scene};
 use crate::shading::{GI_MAX_BOUNCES, Mode, RayCounts, Settings, Stage};
 

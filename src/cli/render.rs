@@ -6,7 +6,7 @@ use std::io::{self, BufWriter, IsTerminal, Write};
 use anyhow::Context;
 use clap::ValueEnum;
 use glam::Vec3;
-use raytty::denoise::render_denoised;
+use raytty::render::render_denoised;
 use raytty::{CellGrid, ColorMode, PointLight, Scene, encode_text, render};
 
 use raytty::image::MAX_PIXELS;

@@ -21,11 +21,7 @@ pub use guides::{GuidePixel, Guides, luminance};
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::camera::Camera;
 use crate::image::Image;
-use crate::render::{Frame, HitCache, render_guided};
-use crate::scene::{PointLight, Scene};
-use crate::shading::Settings;
 
 /// À-trous passes: the taps of pass `i` are `2^i` pixels apart, so four passes of a 3×3 kernel
 /// reach 15 pixels out. Measured at 200×100 against the 4096-spp reference (`cargo run
@@ -83,34 +79,6 @@ struct Surface {
     position: Vec<Vec3>,
     /// Object and reflection count; `u64::MAX` for a pixel left out of the filter.
     key: Vec<u64>,
-}
-
-/// Renders a frame and, if its indirect light is path traced, denoises it: the frame's image
-/// is the denoised one and its time includes the filter's. Other frames are as
-/// [`crate::render::render`] gives them.
-pub fn render_denoised(
-    scene: &Scene,
-    camera: &Camera,
-    lights: &[PointLight],
-    settings: &Settings,
-    width: u32,
-    height: u32,
-) -> Frame {
-    let mut frame = render_guided(
-        scene,
-        camera,
-        lights,
-        settings,
-        width,
-        height,
-        &mut HitCache::new(),
-    );
-    if let Some(g) = &frame.guides {
-        let start = std::time::Instant::now();
-        frame.image = denoise(g).image;
-        frame.stats.elapsed += start.elapsed();
-    }
-    frame
 }
 
 /// Denoises a frame's indirect light. The image has the guides' size.
