@@ -427,3 +427,62 @@ fn light_on_a_scene_without_lights_is_refused() {
     assert!(err.contains("this scene has none"), "{err}");
     assert!(plain.status.success());
 }
+
+/// `--color` picks render's text format, on `render` or before it; with an image output only
+/// the one given to `render` is refused (it cannot apply), the other is for text.
+#[test]
+fn color_picks_the_text_format_of_render() {
+    let text = |args: &[&str]| {
+        let out = raytty(args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let ascii = text(&["render", "--size", "8x4", "--format", "ascii"]);
+    let ansi256 = text(&["render", "--size", "8x4", "--format", "ansi256"]);
+    assert_ne!(ascii, ansi256);
+    assert_eq!(
+        text(&["render", "--size", "8x4", "--color", "ascii"]),
+        ascii
+    );
+    assert_eq!(
+        text(&["render", "--size", "8x4", "--color", "256"]),
+        ansi256
+    );
+    assert_eq!(
+        text(&["--color", "256", "render", "--size", "8x4"]),
+        ansi256
+    );
+    // An explicit --format on render wins over a --color given before it.
+    assert_eq!(
+        text(&[
+            "--color", "256", "render", "--size", "8x4", "--format", "ascii"
+        ]),
+        ascii
+    );
+    let out = raytty(&["render", "--color", "256", "--format", "ascii"]);
+    assert_eq!(out.status.code(), Some(2));
+    let png = std::env::temp_dir().join(format!("raytty-color-{}.png", std::process::id()));
+    let out = raytty(&["render", "--color", "256", "-o", png.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("--color sets a text format"), "{err}");
+    let out = raytty(&[
+        "--color",
+        "256",
+        "render",
+        "--size",
+        "4x2",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let _ = std::fs::remove_file(&png);
+}

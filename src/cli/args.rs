@@ -144,6 +144,10 @@ pub(super) struct RenderArgs {
     /// ascii if NO_COLOR is set).
     #[arg(long, value_enum)]
     pub(super) format: Option<Format>,
+    /// The text format by colours, as the app's --color: auto, truecolor (ansi), 256 (ansi256)
+    /// or ascii. For text frames only.
+    #[arg(long, value_enum, conflicts_with = "format")]
+    pub(super) color: Option<ColorChoice>,
     /// Shading stage: flat, light, direct, shadows, indirect (the default) or gi.
     #[arg(long, value_parser = parse_stage, default_value = "indirect")]
     pub(super) stage: Stage,

@@ -19,7 +19,7 @@ use raytty::{ColorMode, Stage};
 
 use args::*;
 use bench::run_bench;
-use render::{run_render, without_os_error};
+use render::{RenderColor, run_render, text_format, without_os_error};
 
 /// Parses the command line, runs it, and maps the outcome to an exit code.
 pub fn main() -> ExitCode {
@@ -32,6 +32,10 @@ pub fn main() -> ExitCode {
     let matches = cmd.get_matches_mut();
     global_conflicts(&mut cmd, &matches).unwrap_or_else(|e| e.exit());
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    // `raytty --color 256 render` means what `raytty render --color 256` does.
+    let color_given = (matches.value_source("color")
+        == Some(clap::parser::ValueSource::CommandLine))
+    .then_some(cli.color);
     let dumb = is_dumb(std::env::var("TERM").ok().as_deref());
     let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
     let color = resolve_color(
@@ -41,7 +45,18 @@ pub fn main() -> ExitCode {
     );
     let result = match cli.command {
         Some(Command::Render(args)) => {
-            run_render(&args, cli.scene.as_deref(), no_color).map(|()| ExitCode::SUCCESS)
+            let resolve = |c| {
+                resolve_color(
+                    c,
+                    dumb || no_color,
+                    std::env::var("COLORTERM").ok().as_deref(),
+                )
+            };
+            let colors = RenderColor {
+                own: args.color.map(resolve),
+                inherited: color_given.map(resolve),
+            };
+            run_render(&args, cli.scene.as_deref(), no_color, colors).map(|()| ExitCode::SUCCESS)
         }
         Some(Command::Scenes) => stdout_is_open("the list").and_then(|()| {
             io::stdout()
@@ -211,11 +226,8 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
         &RenderArgs {
             size: Some((80, 24)),
             pixels: None,
-            format: Some(match color {
-                ColorMode::TrueColor => Format::Ansi,
-                ColorMode::Ansi256 => Format::Ansi256,
-                ColorMode::Ascii => Format::Ascii,
-            }),
+            format: Some(text_format(color)),
+            color: None,
             stage: Stage::Indirect,
             samples: None,
             denoise: Switch::On,
@@ -226,6 +238,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
         },
         scene,
         false,
+        RenderColor::default(),
     )?;
     Ok(ExitCode::SUCCESS)
 }

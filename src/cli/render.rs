@@ -14,8 +14,24 @@ use raytty::image::MAX_PIXELS;
 use super::args::*;
 use super::{Result, usage};
 
-/// `raytty render`; `no_color` (NO_COLOR is set) makes ascii the default text format.
-pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool) -> Result<()> {
+/// `--color` for `raytty render`, resolved: render's own, or the one given before the command
+/// (`raytty --color 256 render`).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct RenderColor {
+    /// `raytty render --color`: picks the text format; refused with an image output.
+    pub(super) own: Option<ColorMode>,
+    /// `raytty --color … render`: picks the text format; images ignore it.
+    pub(super) inherited: Option<ColorMode>,
+}
+
+/// `raytty render`; `no_color` (NO_COLOR is set) makes ascii the default text format, and
+/// `color` picks the text format when `--format` is not given.
+pub(super) fn run_render(
+    args: &RenderArgs,
+    scene: Option<&str>,
+    no_color: bool,
+    color: RenderColor,
+) -> Result<()> {
     if let Some(ext) = args.output.as_deref().and_then(unwritable_image_extension) {
         usage!(
             "-o {}: raytty cannot write .{ext} images: use a .png or .pfm file name (or --format ascii|ansi|ansi256 for text)",
@@ -25,12 +41,22 @@ pub(super) fn run_render(args: &RenderArgs, scene: Option<&str>, no_color: bool)
                 .display()
         );
     }
-    let format = args
-        .format
-        .unwrap_or_else(|| match format_for(args.output.as_deref()) {
-            Format::Ansi if no_color => Format::Ascii,
-            f => f,
-        });
+    let format = match (args.format, color.own, format_for(args.output.as_deref())) {
+        (Some(f), _, _) => f,
+        (None, Some(_), Format::Png | Format::Pfm) => {
+            usage!(
+                "--color sets a text format, and -o {} is an image: drop one of them",
+                args.output.as_deref().unwrap_or("".as_ref()).display()
+            );
+        }
+        (None, Some(mode), _) => text_format(mode),
+        (None, None, Format::Ansi) => match color.inherited {
+            Some(mode) => text_format(mode),
+            None if no_color => Format::Ascii,
+            None => Format::Ansi,
+        },
+        (None, None, f) => f,
+    };
     let image_format = matches!(format, Format::Png | Format::Pfm);
     if image_format && args.output.is_none() && io::stdout().is_terminal() {
         usage!(
@@ -200,6 +226,15 @@ pub(super) fn unwritable_image_extension(path: &std::path::Path) -> Option<Strin
     ];
     let ext = path.extension()?.to_str()?.to_ascii_lowercase();
     IMAGES.contains(&ext.as_str()).then_some(ext)
+}
+
+/// The text format that shows `mode`'s colours.
+pub(super) fn text_format(mode: ColorMode) -> Format {
+    match mode {
+        ColorMode::TrueColor => Format::Ansi,
+        ColorMode::Ansi256 => Format::Ansi256,
+        ColorMode::Ascii => Format::Ascii,
+    }
 }
 
 /// A format's name as `--format` spells it.
