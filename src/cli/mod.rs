@@ -38,20 +38,11 @@ pub fn main() -> ExitCode {
     .then_some(cli.color);
     let dumb = is_dumb(std::env::var("TERM").ok().as_deref());
     let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
-    let color = resolve_color(
-        cli.color,
-        dumb || no_color,
-        std::env::var("COLORTERM").ok().as_deref(),
-    );
+    let colorterm = std::env::var("COLORTERM").ok();
+    let resolve = |c| resolve_color(c, dumb || no_color, colorterm.as_deref());
+    let color = resolve(cli.color);
     let result = match cli.command {
         Some(Command::Render(args)) => {
-            let resolve = |c| {
-                resolve_color(
-                    c,
-                    dumb || no_color,
-                    std::env::var("COLORTERM").ok().as_deref(),
-                )
-            };
             let colors = RenderColor {
                 own: args.color.map(resolve),
                 inherited: color_given.map(resolve),
