@@ -15,8 +15,8 @@ mod slow_link;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use raytty::{CellGrid, ColorMode, Stage, cornell_box, render};
-use slow_link::{SlowLink, max_error};
+use raytty::{CellGrid, cornell_box};
+use slow_link::{SlowLink, app_image, max_error};
 
 /// Presses per held key, and the time between them.
 const PRESSES: usize = 10;
@@ -51,16 +51,7 @@ fn expected(cols: u16, rows: u16, motion: Motion, presses: usize) -> CellGrid {
             }
         }
     }
-    let settings = Stage::Indirect.settings(scene.effects());
-    let frame = render(
-        &scene,
-        &camera,
-        &lights,
-        &settings,
-        cols as u32,
-        2 * (rows as u32 - 1),
-    );
-    CellGrid::from_image(&frame.image, ColorMode::TrueColor)
+    app_image(&camera, &lights, cols, rows)
 }
 
 struct Row {

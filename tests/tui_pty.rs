@@ -15,7 +15,7 @@ mod slow_link;
 use glam::Vec3;
 use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system};
 use raytty::frame::Colour;
-use raytty::{CellGrid, ColorMode, Stage, cornell_box, render};
+use raytty::{CellGrid, cornell_box};
 
 /// How long any one condition may take before the test fails: generous, for a loaded machine
 /// (a 60×20 frame renders in milliseconds).
@@ -194,16 +194,7 @@ fn expected(cols: u16, rows: u16, camera_z: f32, light_y: f32) -> CellGrid {
     camera.position += camera.forward() * camera_z;
     let mut lights = scene.lights().to_vec();
     lights[0].position += camera.to_world(Vec3::new(0.0, light_y, 0.0));
-    let settings = Stage::Indirect.settings(scene.effects());
-    let frame = render(
-        &scene,
-        &camera,
-        &lights,
-        &settings,
-        cols as u32,
-        2 * (rows as u32 - 1),
-    );
-    CellGrid::from_image(&frame.image, ColorMode::TrueColor)
+    slow_link::app_image(&camera, &lights, cols, rows)
 }
 
 fn nonzero(n: u16) -> NonZeroU16 {
@@ -629,16 +620,7 @@ fn over_a_slow_link_a_move_is_sent_approximately_then_settles_exact() {
     for _ in 0..5 {
         lights[0].position += camera.to_world(Vec3::new(0.0, 0.0, 1.0) * (0.1 * 1.0));
     }
-    let settings = Stage::Indirect.settings(scene.effects());
-    let frame = render(
-        &scene,
-        &camera,
-        &lights,
-        &settings,
-        cols as u32,
-        2 * (rows as u32 - 1),
-    );
-    let moved = CellGrid::from_image(&frame.image, ColorMode::TrueColor);
+    let moved = slow_link::app_image(&camera, &lights, cols, rows);
     // The status line says so while the screen is approximate (for many frames at 60 kB/s).
     let mut seen_approximate = false;
     let settled = link.wait_for(TIMEOUT, |s| {

@@ -79,6 +79,7 @@ impl Flat {
 
     /// Closest hit on path `isa` (must be available).
     pub fn intersect(&self, isa: Isa, ray: &Ray, t_max: f32) -> Option<Hit> {
+        debug_assert!(isa.available(), "{} is not available", isa.name());
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller passes an available path.
@@ -91,6 +92,7 @@ impl Flat {
 
     /// Any hit on path `isa` (must be available).
     pub fn occluded(&self, isa: Isa, ray: &Ray, t_max: f32) -> bool {
+        debug_assert!(isa.available(), "{} is not available", isa.name());
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller passes an available path.

@@ -9,8 +9,8 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system};
-use raytty::CellGrid;
 use raytty::frame::{Colour, pixels};
+use raytty::{Camera, CellGrid, ColorMode, PointLight, Stage, cornell_box, render};
 
 /// The most the link lets through at once after an idle spell, in time at its rate (a real
 /// link's queue): long enough that the reader's own scheduling delays on a busy machine do not
@@ -186,4 +186,20 @@ pub fn max_error(screen: &vt100::Screen, want: &CellGrid) -> u16 {
         }
     }
     worst
+}
+
+/// The image the app shows (truecolor, without its status line) in a `cols × rows` terminal
+/// with the Cornell box seen from `camera` under `lights`.
+pub fn app_image(camera: &Camera, lights: &[PointLight], cols: u16, rows: u16) -> CellGrid {
+    let scene = cornell_box();
+    let settings = Stage::Indirect.settings(scene.effects());
+    let frame = render(
+        &scene,
+        camera,
+        lights,
+        &settings,
+        u32::from(cols),
+        2 * (u32::from(rows) - 1),
+    );
+    CellGrid::from_image(&frame.image, ColorMode::TrueColor)
 }
