@@ -9,13 +9,16 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::accel::Hit;
+use crate::accel::{Hit, TILE_RAYS, TileCache};
 use crate::camera::Camera;
 use crate::denoise::{GuidePixel, Guides, denoise};
 use crate::image::Image;
 use crate::rng::Rng;
 use crate::scene::{PointLight, Scene};
 use crate::shading::{RayCounts, Settings, Tracer};
+
+/// The side of a tile of camera rays traced together (`TILE`² = [`TILE_RAYS`]).
+const TILE: usize = 8;
 
 /// What a frame cost.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -188,23 +191,52 @@ fn render_impl(
         if !reuse {
             cache.hits.resize(w * h, None);
         }
+        // Bands of `TILE` rows, walked in tiles of `TILE`×`TILE` pixels: each tile's camera
+        // rays are traced together (`Scene::intersect_tile`), then shaded pixel by pixel.
         let counts = image
             .pixels
-            .par_chunks_mut(w)
-            .zip(cache.hits.par_chunks_mut(w))
-            .zip(guide_rows.par_iter_mut())
+            .par_chunks_mut(TILE * w)
+            .zip(cache.hits.par_chunks_mut(TILE * w))
+            .zip(guide_rows.par_chunks_mut(TILE))
             .enumerate()
-            .map(|(y, ((row, hits), guide_row))| {
+            .map(|(band, ((pixels, hits), guide_rows))| {
                 let mut n = RayCounts::default();
-                for (x, (px, hit)) in row.iter_mut().zip(hits.iter_mut()).enumerate() {
-                    let ray = rays.ray(x as f32 + 0.5, y as f32 + 0.5);
-                    if !reuse {
-                        n.primary += 1;
-                        *hit = scene.intersect(&ray, f32::INFINITY);
+                let (y0, rows) = (band * TILE, guide_rows.len());
+                let mut tile_rays = Vec::with_capacity(TILE_RAYS);
+                let mut tile_hits = [None; TILE_RAYS];
+                let mut tile_cache = TileCache::default();
+                for x0 in (0..w).step_by(TILE) {
+                    let cols = (w - x0).min(TILE);
+                    tile_rays.clear();
+                    for dy in 0..rows {
+                        for x in x0..x0 + cols {
+                            let y = y0 + dy;
+                            tile_rays.push(rays.ray(x as f32 + 0.5, y as f32 + 0.5));
+                        }
                     }
-                    let mut rng = Rng::for_sample((y * w + x) as u64, 0, settings.frame);
-                    let g = guide_row.as_mut().map(|r| &mut r[x]);
-                    *px = sample(&tracer, &ray, *hit, &mut rng, &mut n, g);
+                    let k = tile_rays.len();
+                    if !reuse {
+                        n.primary += k as u64;
+                        scene.intersect_tile(
+                            &tile_rays,
+                            f32::INFINITY,
+                            &mut tile_hits[..k],
+                            &mut tile_cache,
+                        );
+                    }
+                    for (i, ray) in tile_rays.iter().enumerate() {
+                        let (dy, x) = (i / cols, x0 + i % cols);
+                        let at = dy * w + x;
+                        if reuse {
+                            tile_hits[i] = hits[at];
+                        } else {
+                            hits[at] = tile_hits[i];
+                        }
+                        let y = y0 + dy;
+                        let mut rng = Rng::for_sample((y * w + x) as u64, 0, settings.frame);
+                        let g = guide_rows[dy].as_mut().map(|r| &mut r[x]);
+                        pixels[at] = sample(&tracer, ray, tile_hits[i], &mut rng, &mut n, g);
+                    }
                 }
                 n
             })
