@@ -83,15 +83,7 @@ pub fn render(
     width: u32,
     height: u32,
 ) -> Frame {
-    render_cached(
-        scene,
-        camera,
-        lights,
-        settings,
-        width,
-        height,
-        &mut HitCache::new(),
-    )
+    render_impl(scene, camera, lights, settings, width, height, None, false)
 }
 
 /// Renders a frame, reusing `cache`'s primary hits when they are still valid (one sample per
@@ -105,7 +97,16 @@ pub fn render_cached(
     height: u32,
     cache: &mut HitCache,
 ) -> Frame {
-    render_impl(scene, camera, lights, settings, width, height, cache, false)
+    render_impl(
+        scene,
+        camera,
+        lights,
+        settings,
+        width,
+        height,
+        Some(cache),
+        false,
+    )
 }
 
 /// [`render_cached`], and with path-traced indirect light the denoiser's guide buffers too
@@ -119,7 +120,16 @@ pub fn render_guided(
     height: u32,
     cache: &mut HitCache,
 ) -> Frame {
-    render_impl(scene, camera, lights, settings, width, height, cache, true)
+    render_impl(
+        scene,
+        camera,
+        lights,
+        settings,
+        width,
+        height,
+        Some(cache),
+        true,
+    )
 }
 
 /// One sample through `ray`. A path-traced frame's sample is split (the same colour either
@@ -152,7 +162,7 @@ fn render_impl(
     settings: &Settings,
     width: u32,
     height: u32,
-    cache: &mut HitCache,
+    mut cache: Option<&mut HitCache>,
     guided: bool,
 ) -> Frame {
     let start = Instant::now();
@@ -163,6 +173,7 @@ fn render_impl(
     let mut image = Image::new(width, height);
     // Path-traced frames split every sample for the denoiser (same colour, in any case).
     let split = tracer.splits();
+    let draws = tracer.draws_random_numbers();
     let mut guides = (guided && split).then(|| Guides {
         width,
         height,
@@ -187,16 +198,25 @@ fn render_impl(
 
     let key = Some((camera_key(camera), width, height));
     let counts = if samples == 1 {
-        let reuse = cache.key == key && cache.hits.len() == w * h;
-        if !reuse {
-            cache.hits.resize(w * h, None);
-        }
+        let reuse = cache
+            .as_ref()
+            .is_some_and(|c| c.key == key && c.hits.len() == w * h);
+        // The cache's rows by band, or none (a frame whose hits nobody keeps stores none).
+        let mut hit_bands: Vec<Option<&mut [Option<Hit>]>> = match cache.as_mut() {
+            Some(c) => {
+                if !reuse {
+                    c.hits.resize(w * h, None);
+                }
+                c.hits.chunks_mut(TILE * w).map(Some).collect()
+            }
+            None => (0..h.div_ceil(TILE)).map(|_| None).collect(),
+        };
         // Bands of `TILE` rows, walked in tiles of `TILE`×`TILE` pixels: each tile's camera
         // rays are traced together (`Scene::intersect_tile`), then shaded pixel by pixel.
         let counts = image
             .pixels
             .par_chunks_mut(TILE * w)
-            .zip(cache.hits.par_chunks_mut(TILE * w))
+            .zip(hit_bands.par_iter_mut())
             .zip(guide_rows.par_chunks_mut(TILE))
             .enumerate()
             .map(|(band, ((pixels, hits), guide_rows))| {
@@ -227,13 +247,18 @@ fn render_impl(
                     for (i, ray) in tile_rays.iter().enumerate() {
                         let (dy, x) = (i / cols, x0 + i % cols);
                         let at = dy * w + x;
-                        if reuse {
-                            tile_hits[i] = hits[at];
-                        } else {
-                            hits[at] = tile_hits[i];
+                        match hits {
+                            Some(h) if reuse => tile_hits[i] = h[at],
+                            Some(h) => h[at] = tile_hits[i],
+                            None => {}
                         }
                         let y = y0 + dy;
-                        let mut rng = Rng::for_sample((y * w + x) as u64, 0, settings.frame);
+                        // Only path-traced light draws random numbers: skip the hash otherwise.
+                        let mut rng = if draws {
+                            Rng::for_sample((y * w + x) as u64, 0, settings.frame)
+                        } else {
+                            Rng::seeded(0)
+                        };
                         let g = guide_rows[dy].as_mut().map(|r| &mut r[x]);
                         pixels[at] = sample(&tracer, ray, tile_hits[i], &mut rng, &mut n, g);
                     }
@@ -241,7 +266,10 @@ fn render_impl(
                 n
             })
             .reduce(RayCounts::default, sum);
-        cache.key = key;
+        drop(hit_bands);
+        if let Some(c) = cache {
+            c.key = key;
+        }
         counts
     } else {
         let strata = (samples as f32).sqrt() as u32;
@@ -356,15 +384,7 @@ pub fn render_denoised(
     width: u32,
     height: u32,
 ) -> Frame {
-    let mut frame = render_guided(
-        scene,
-        camera,
-        lights,
-        settings,
-        width,
-        height,
-        &mut HitCache::new(),
-    );
+    let mut frame = render_impl(scene, camera, lights, settings, width, height, None, true);
     if let Some(g) = &frame.guides {
         let start = Instant::now();
         frame.image = denoise(g).image;
