@@ -56,6 +56,7 @@ fn path_traced_frames_are_deterministic_across_threads() {
                     shadows: true,
                     indirect: Indirect::PathTraced { bounces: 3 },
                     samples: 2,
+                    ..Effects::SEED
                 };
                 render(&scene, &scene.camera(), scene.lights(), &s, 40, 30).image
             })

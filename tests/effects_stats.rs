@@ -16,6 +16,7 @@ fn settings(shadows: bool, indirect: Indirect, samples: u32) -> Settings {
         shadows,
         indirect,
         samples,
+        ..Effects::SEED
     };
     s
 }

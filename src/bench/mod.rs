@@ -195,6 +195,7 @@ impl RowKind {
                     shadows: true,
                     indirect: Indirect::PathTraced { bounces },
                     samples: spp,
+                    sampler: scene.effects().sampler,
                 },
                 frame: 0,
             },

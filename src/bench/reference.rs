@@ -12,6 +12,7 @@ use super::progress::Progress;
 
 use crate::image::Image;
 use crate::render::render;
+use crate::sampler::Sampler;
 use crate::scene::{Effects, Indirect, Scene};
 use crate::shading::{Mode, Settings};
 
@@ -81,6 +82,9 @@ impl ReferenceSpec {
                     bounces: self.bounces,
                 },
                 samples: PASS_SPP,
+                // The cached references were rendered with independent numbers: keep them,
+                // bit for bit.
+                sampler: Sampler::Independent,
             },
             frame: FRAME_BASE + pass,
         }
