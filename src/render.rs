@@ -13,7 +13,7 @@ use crate::accel::Hit;
 use crate::camera::Camera;
 use crate::denoise::{GuidePixel, Guides, denoise};
 use crate::image::Image;
-use crate::sampler::{SampleSource, Stream};
+use crate::sampler::{SampleSource, Sampler, Stream};
 use crate::scene::{PointLight, Scene};
 use crate::shading::{RayCounts, Settings, Tracer};
 
@@ -154,8 +154,13 @@ fn render_impl(
 ) -> Frame {
     let start = Instant::now();
     let samples = settings.effects.samples.max(1);
-    let sampler = settings.effects.sampler;
     let tracer = Tracer::new(scene, lights, *settings);
+    // The sampler drives path-traced frames; the others keep their independent numbers.
+    let sampler = if tracer.splits() {
+        settings.effects.sampler
+    } else {
+        Sampler::Independent
+    };
     let rays = camera.rays(width, height);
     let (w, h) = (width as usize, height as usize);
     let mut image = Image::new(width, height);
