@@ -372,6 +372,18 @@ mod tests {
         let _ = fs::remove_dir_all(&tmp);
     }
 
+    /// References take independent numbers, whatever the scene's sampler: their cached files
+    /// were rendered so (`tests/determinism.rs` pins that sampler's frames bit for bit).
+    #[test]
+    fn references_use_independent_numbers() {
+        let scene = crate::scene::cornell::cornell_box();
+        assert_eq!(scene.effects().sampler, Sampler::Sobol);
+        let spec = ReferenceSpec::new(&scene, 12, 10, 32, 4);
+        for pass in 0..2 {
+            assert_eq!(spec.settings(pass).effects.sampler, Sampler::Independent);
+        }
+    }
+
     /// A corrupt cache file (here a header whose size overflows, which used to be read with
     /// an unchecked `width·height·12`) is refused with a message, removed, and rendered again.
     #[test]
