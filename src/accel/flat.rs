@@ -3,7 +3,7 @@
 //! to a [`Box4`]. A closest-hit query slab-tests every box four at a time, then visits the
 //! objects it meets nearest entry first, testing their blocks with the SIMD kernels, and stops
 //! once the next object starts beyond the best hit ([`cull_bound`]). An any-hit query stops at
-//! the first confirmed hit.
+//! the first hit.
 
 use std::ops::Range;
 

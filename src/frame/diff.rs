@@ -5,7 +5,10 @@
 //! - a block cell is drawn whichever way the pen's colours carry over best: `▀` (upper pixel
 //!   as foreground) or `▄` (lower pixel as foreground), and a cell of one colour as a space
 //!   (background) or `█` (foreground);
-//! - one SGR sets the foreground and the background together, and only what changes.
+//! - one SGR sets the foreground and the background together, and only what changes;
+//! - an exact diff sends its block cells in the order that reuses the pen's colours most,
+//!   across the whole screen (`exact.rs`); within a tolerance, row by row, each row's next
+//!   cell the cheapest of the next few.
 
 use super::{Cell, CellGrid, Colour, Pen, UPPER_HALF, WIDE_TAIL, half_block, write_char};
 
@@ -14,7 +17,7 @@ pub const LOWER_HALF: char = '▄';
 /// The full block: its foreground paints both pixels.
 pub const FULL_BLOCK: char = '█';
 
-/// Within a row, the next cell sent is the cheapest (cursor move, SGR, character) of the next
+/// Within a row of a diff within a tolerance (and for text), the next cell sent is the cheapest (cursor move, SGR, character) of the next
 /// this many cells to send: a few bytes of cursor move buy a cell whose colours the pen holds.
 const ORDER_WINDOW: usize = 16;
 
@@ -141,6 +144,16 @@ pub fn encode_diff_within(
         max_error: 0,
     };
     let cols = next.cols;
+    if limits.tolerance == 0 {
+        exact::send_block_cells(
+            screen,
+            next,
+            limits.first_row,
+            &mut w,
+            out,
+            (start, limits.max_bytes),
+        );
+    }
     'rows: for k in 0..next.rows {
         let r = (limits.first_row + k) % next.rows.max(1);
         let row = r * cols..(r + 1) * cols;
@@ -330,20 +343,18 @@ impl Writer {
             .unwrap_or(0)
     }
 
-    /// Bytes of [`Writer::move_to`] (row, col).
+    /// Bytes of [`Writer::move_to`] (row, col), counted without writing them.
     fn move_len(&self, r: usize, c: usize) -> usize {
+        let horizontal = |from: usize, to: usize| relative_len(from.abs_diff(to));
+        let cup = 4 + decimal_len(self.top + r + 1) + decimal_len(c + 1);
         match self.cursor {
-            Some((cr, cc)) if cr == r => match cc.abs_diff(c) {
-                0 => 0,
-                1 => 3,
-                n => 3 + n.to_string().len(),
-            },
-            _ => {
-                let mut scratch = Vec::new();
-                let mut w = *self;
-                w.move_to(&mut scratch, r, c);
-                scratch.len()
+            Some((cr, cc)) if cr == r => cup.min(horizontal(cc, c)),
+            Some((cr, cc)) if cr < r => {
+                let down = r - cr;
+                cup.min(1 + down + horizontal(0, c))
+                    .min(relative_len(down) + horizontal(cc, c))
             }
+            _ => cup,
         }
     }
 
@@ -369,8 +380,23 @@ impl Writer {
             }
             _ => {}
         }
+        debug_assert_eq!(best.len(), self.move_len(r, c));
         out.extend_from_slice(best.as_bytes());
         self.cursor = Some((r, c));
+    }
+}
+
+/// Bytes of the decimal form of `n`.
+fn decimal_len(n: usize) -> usize {
+    n.checked_ilog10().map_or(1, |d| d as usize + 1)
+}
+
+/// Bytes of [`relative`] by `n` (0: no move).
+fn relative_len(n: usize) -> usize {
+    match n {
+        0 => 0,
+        1 => 3,
+        n => 3 + decimal_len(n),
     }
 }
 
@@ -383,5 +409,6 @@ fn relative(n: usize, f: char) -> String {
     }
 }
 
+mod exact;
 #[cfg(test)]
 mod tests;

@@ -17,6 +17,10 @@ pub struct TriHit {
 /// The watertight ray/triangle test. Two-sided. Returns `None` for a miss, for a hit at or
 /// beyond `t_max`, and for a hit whose `t` is within its own rounding error of zero
 /// ([`t_error_bound`]).
+///
+/// The SIMD kernels (`accel/tri4/x86.rs`) repeat this test and [`t_error_bound`] operation for
+/// operation, in this order: a change here must be made there too (`tests/simd_kernels.rs`
+/// holds them to each other bit for bit).
 #[inline]
 pub fn intersect_watertight(ray: &Ray, v: &[Vec3; 3], t_max: f32) -> Option<TriHit> {
     let frame = ray.frame(v);

@@ -3,37 +3,36 @@
 //!
 //! # Bit-identical to the scalar test, by construction
 //!
-//! The SIMD kernels do not replace [`intersect_watertight`]: they run its first steps lane by
-//! lane — the sheared vertices, the three edge functions, the sign test, the determinant and
-//! the range of `t·det` — with the same `f32` operations in the same order (no fused
-//! multiply-add: the AVX2 path enables `avx2` only, not `fma`), and keep the lanes the scalar
-//! test would not reject at those steps: the *candidates*. A lane whose edge function rounds to
-//! exactly 0 is always a candidate, since the scalar test then redoes the edges in `f64`. Each
-//! candidate is then confirmed by [`intersect_watertight`] itself, which computes the hit that is
-//! reported. So a kernel can only differ from the scalar loop by rejecting a triangle the scalar
-//! test accepts; `tests/simd_kernels.rs` holds every path to the scalar one over the stability
-//! suite's and the accel tests' rays, and the candidates' `t` to the scalar `t` bit for bit.
-//!
-//! A candidate's `t` is also computed in SIMD (`t·det · (1/det)`, as the scalar test does), so
-//! a closest-hit query confirms candidates nearest first and skips those that cannot beat the
-//! best hit so far: one scalar confirmation per query in the common case.
+//! The SIMD kernels run the whole of [`intersect_watertight`] lane by lane — the sheared
+//! vertices, the edge functions, the sign test, the determinant, the range of `t·det`, `t`,
+//! its error bound ([`crate::geometry::t_error_bound`]) and the barycentrics — with the same
+//! `f32` operations in the same order (no fused multiply-add: the AVX2 path enables `avx2`
+//! only, not `fma`; IEEE division and square-free arithmetic round the same on every path).
+//! So a lane the kernel accepts carries the scalar test's own `t` and barycentrics, bit for
+//! bit, and a lane it rejects is one the scalar test rejects. The one exception is a lane whose
+//! edge function rounds to exactly 0: the scalar test redoes its edges in `f64`, so the kernel
+//! hands that lane back (`redo`) and the search runs [`intersect_watertight`] on it.
+//! `tests/simd_kernels.rs` holds every path to the scalar test over the stability suite's and
+//! the accel tests' rays: accepted lanes, `t` and barycentrics bit for bit.
 //!
 //! # Which path
 //!
 //! [`Isa::detect`] picks the widest the CPU has at run time: AVX2 (eight lanes: two blocks per
-//! step), else SSE2 (four lanes; part of every x86-64), else the portable twin, which runs the
-//! same operations one lane at a time. No `target-cpu` is needed or committed.
+//! step), else SSE2 (four lanes; part of every x86-64), else the portable path, which runs the
+//! scalar test one lane at a time. No `target-cpu` is needed or committed.
 
 use glam::Vec3;
 
 use super::box4::Box4;
-use super::hit::{Hit, shrunk_t_max};
 use super::isa::Isa;
-use crate::geometry::{Ray, intersect_watertight};
+use crate::geometry::Ray;
 
 mod portable;
+mod search;
+#[cfg(target_arch = "x86_64")]
+mod x86;
 
-pub use portable::{candidates_portable, candidates2_portable};
+pub(crate) use search::{Closest, blocks_closest, blocks_occluded};
 
 /// Triangles per [`Tri4`] block.
 pub const LANES: usize = 4;
@@ -130,43 +129,56 @@ impl RayLanes {
     }
 }
 
-/// The candidates of a step: a bit per lane, and each lane's `t` (−∞ where the scalar test
-/// redoes the edges in `f64` and `t` is not known yet; meaningless where the bit is clear).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Candidates {
-    /// Bit `i` set: lane `i` may hit.
+/// What a kernel found in one or two blocks (lanes 4-7 from the second).
+#[derive(Clone, Copy, Debug)]
+pub struct Hits {
+    /// Bit `i` set: lane `i` is hit, at `t[i]` with barycentrics `b[..][i]`, exactly as
+    /// [`intersect_watertight`] computes them.
     pub mask: u32,
-    /// Lane `i`'s `t`, as the scalar test computes it.
+    /// Bit `i` set: lane `i`'s edge function rounded to 0, so the scalar test redoes it in
+    /// `f64`; the kernel says nothing else about it.
+    pub redo: u32,
+    /// Each hit lane's `t` (meaningless elsewhere).
     pub t: [f32; 2 * LANES],
+    /// Each hit lane's barycentric weights of `v0`, `v1`, `v2` (meaningless elsewhere).
+    pub b: [[f32; 2 * LANES]; 3],
 }
 
-impl Candidates {
-    /// Sets the `t` of the candidate lanes in `mask` from their `t·det` and `det` (lanes
-    /// from `first`), as the scalar test computes it; −∞ for lanes in `zero`.
+impl Hits {
+    /// No lane hit, none to redo.
+    pub const NONE: Hits = Hits {
+        mask: 0,
+        redo: 0,
+        t: [0.0; 2 * LANES],
+        b: [[0.0; 2 * LANES]; 3],
+    };
+
+    /// `a`'s lanes, then `b`'s as lanes 4-7.
     #[inline(always)]
-    fn fill_t(&mut self, mask: u32, zero: u32, t_scaled: &[f32], det: &[f32], first: usize) {
-        let mut m = mask;
-        while m != 0 {
-            let l = m.trailing_zeros() as usize;
-            self.t[first + l] = if zero & (1 << l) != 0 {
-                f32::NEG_INFINITY
-            } else {
-                t_scaled[l] * (1.0 / det[l])
+    fn join(a: Hits, b: Hits) -> Hits {
+        if (a.mask | b.mask) == 0 {
+            return Hits {
+                redo: a.redo | b.redo << LANES,
+                ..Hits::NONE
             };
-            m &= m - 1;
         }
+        let mut out = a;
+        out.mask |= b.mask << LANES;
+        out.redo |= b.redo << LANES;
+        out.t[LANES..].copy_from_slice(&b.t[..LANES]);
+        for (o, i) in out.b.iter_mut().zip(&b.b) {
+            o[LANES..].copy_from_slice(&i[..LANES]);
+        }
+        out
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-mod x86;
-
 /// How a traversal tests blocks: one of the three paths, chosen by the type.
 pub(crate) trait Kernel {
-    /// The candidates of one block.
-    fn one(block: &Tri4, r: &RayLanes, t_max: f32) -> Candidates;
-    /// The candidates of two blocks (lanes 4-7 from `b`).
-    fn two(a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Candidates;
+    /// The hits in one block.
+    fn one(block: &Tri4, ray: &Ray, r: &RayLanes, t_max: f32) -> Hits;
+    /// The hits in two blocks (lanes 4-7 from `b`).
+    fn two(a: &Tri4, b: &Tri4, ray: &Ray, r: &RayLanes, t_max: f32) -> Hits;
     /// Which of four boxes the ray meets before `t_max`, and where it enters them.
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]);
 }
@@ -176,12 +188,12 @@ pub(crate) struct Portable;
 
 impl Kernel for Portable {
     #[inline(always)]
-    fn one(block: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
-        candidates_portable(block, r, t_max)
+    fn one(block: &Tri4, ray: &Ray, _: &RayLanes, t_max: f32) -> Hits {
+        portable::hits(block, ray, t_max)
     }
     #[inline(always)]
-    fn two(a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
-        candidates2_portable(a, b, r, t_max)
+    fn two(a: &Tri4, b: &Tri4, ray: &Ray, _: &RayLanes, t_max: f32) -> Hits {
+        Hits::join(portable::hits(a, ray, t_max), portable::hits(b, ray, t_max))
     }
     #[inline(always)]
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
@@ -196,12 +208,12 @@ pub(crate) struct Sse2;
 #[cfg(target_arch = "x86_64")]
 impl Kernel for Sse2 {
     #[inline(always)]
-    fn one(block: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
-        x86::candidates_sse2(block, r, t_max)
+    fn one(block: &Tri4, _: &Ray, r: &RayLanes, t_max: f32) -> Hits {
+        x86::hits_sse2(block, r, t_max)
     }
     #[inline(always)]
-    fn two(a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
-        x86::candidates2_sse2(a, b, r, t_max)
+    fn two(a: &Tri4, b: &Tri4, _: &Ray, r: &RayLanes, t_max: f32) -> Hits {
+        Hits::join(x86::hits_sse2(a, r, t_max), x86::hits_sse2(b, r, t_max))
     }
     #[inline(always)]
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
@@ -217,14 +229,14 @@ pub(crate) struct Avx2;
 #[cfg(target_arch = "x86_64")]
 impl Kernel for Avx2 {
     #[inline(always)]
-    fn one(block: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
+    fn one(block: &Tri4, _: &Ray, r: &RayLanes, t_max: f32) -> Hits {
         // SAFETY: `Avx2` is only instantiated behind a check that the CPU has AVX2.
-        unsafe { x86::candidates_avx2(block, r, t_max) }
+        unsafe { x86::hits_avx2(block, r, t_max) }
     }
     #[inline(always)]
-    fn two(a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
+    fn two(a: &Tri4, b: &Tri4, _: &Ray, r: &RayLanes, t_max: f32) -> Hits {
         // SAFETY: as above.
-        unsafe { x86::candidates2_avx2(a, b, r, t_max) }
+        unsafe { x86::hits2_avx2(a, b, r, t_max) }
     }
     #[inline(always)]
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
@@ -232,184 +244,43 @@ impl Kernel for Avx2 {
     }
 }
 
-/// The candidates of one block on path `isa` (for tests and tools; traversals call the kernels
-/// directly). `isa` must be available.
-pub fn candidates(isa: Isa, block: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
+/// The hits of `ray` in one block on path `isa` (for tests and tools; traversals call the
+/// kernels directly). `isa` must be available.
+pub fn hits(isa: Isa, block: &Tri4, ray: &Ray, t_max: f32) -> Hits {
     assert!(
         isa.available(),
         "{} is not available on this CPU",
         isa.name()
     );
+    let r = RayLanes::new(ray);
     match isa {
-        Isa::Portable => candidates_portable(block, r, t_max),
+        Isa::Portable => Portable::one(block, ray, &r, t_max),
         #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 => x86::candidates_sse2(block, r, t_max),
+        Isa::Sse2 => Sse2::one(block, ray, &r, t_max),
         #[cfg(target_arch = "x86_64")]
         // SAFETY: checked available above.
-        Isa::Avx2 => unsafe { x86::candidates_avx2(block, r, t_max) },
+        Isa::Avx2 => unsafe { x86::hits_avx2(block, &r, t_max) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => unreachable!(),
     }
 }
 
-/// The candidates of two blocks on path `isa` (lanes 4-7 from `b`). `isa` must be available.
-pub fn candidates2(isa: Isa, a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
+/// The hits of `ray` in two blocks on path `isa` (lanes 4-7 from `b`). `isa` must be available.
+pub fn hits2(isa: Isa, a: &Tri4, b: &Tri4, ray: &Ray, t_max: f32) -> Hits {
     assert!(
         isa.available(),
         "{} is not available on this CPU",
         isa.name()
     );
+    let r = RayLanes::new(ray);
     match isa {
-        Isa::Portable => candidates2_portable(a, b, r, t_max),
+        Isa::Portable => Portable::two(a, b, ray, &r, t_max),
         #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 => x86::candidates2_sse2(a, b, r, t_max),
+        Isa::Sse2 => Sse2::two(a, b, ray, &r, t_max),
         #[cfg(target_arch = "x86_64")]
         // SAFETY: checked available above.
-        Isa::Avx2 => unsafe { x86::candidates2_avx2(a, b, r, t_max) },
+        Isa::Avx2 => unsafe { x86::hits2_avx2(a, b, &r, t_max) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => unreachable!(),
     }
-}
-
-/// The closest-hit search's state: the best hit so far and the `t_max` a triangle is tested
-/// with (four ULPs above it, see [`shrunk_t_max`]).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Closest {
-    pub best: Option<Hit>,
-    pub tri_t_max: f32,
-    pub t_max: f32,
-}
-
-impl Closest {
-    #[inline(always)]
-    pub fn new(t_max: f32) -> Closest {
-        Closest {
-            best: None,
-            tri_t_max: t_max,
-            t_max,
-        }
-    }
-
-    /// Confirms `c`'s candidates nearest first with the scalar test, skipping those that cannot
-    /// beat the best hit. `vertices(lane)` and `id(lane)` give a lane's triangle.
-    #[inline(always)]
-    pub fn take(
-        &mut self,
-        ray: &Ray,
-        mut c: Candidates,
-        vertices: impl Fn(usize) -> [Vec3; 3],
-        id: impl Fn(usize) -> u32,
-    ) {
-        while c.mask != 0 {
-            // The lowest t among the candidates (ties: the lowest lane).
-            let mut lane = c.mask.trailing_zeros() as usize;
-            let mut m = c.mask & (c.mask - 1);
-            while m != 0 {
-                let l = m.trailing_zeros() as usize;
-                if c.t[l] < c.t[lane] {
-                    lane = l;
-                }
-                m &= m - 1;
-            }
-            c.mask &= !(1 << lane);
-            let (t, i) = (c.t[lane], id(lane));
-            // A lane whose t is known and cannot beat the best: the scalar test would give the
-            // same t, so skip it.
-            if let Some(b) = self.best
-                && t != f32::NEG_INFINITY
-                && (t > b.t || t == b.t && i > b.triangle)
-            {
-                continue;
-            }
-            let Some(h) = intersect_watertight(ray, &vertices(lane), self.tri_t_max) else {
-                continue;
-            };
-            if self
-                .best
-                .is_none_or(|b| h.t < b.t || h.t == b.t && i < b.triangle)
-            {
-                self.best = Some(Hit {
-                    t: h.t,
-                    b: h.b,
-                    triangle: i,
-                });
-                self.tri_t_max = shrunk_t_max(h.t, self.t_max);
-            }
-        }
-    }
-}
-
-/// Whether any candidate of `c` is confirmed by the scalar test with `t_max`.
-#[inline(always)]
-pub(crate) fn any_confirmed(
-    ray: &Ray,
-    c: Candidates,
-    t_max: f32,
-    vertices: impl Fn(usize) -> [Vec3; 3],
-) -> bool {
-    let mut m = c.mask;
-    while m != 0 {
-        let lane = m.trailing_zeros() as usize;
-        if intersect_watertight(ray, &vertices(lane), t_max).is_some() {
-            return true;
-        }
-        m &= m - 1;
-    }
-    false
-}
-
-/// Folds the closest hit among consecutive `blocks` (whose lanes' scene indices are `ids`) into
-/// `c`: two blocks per step where there are two.
-#[inline(always)]
-pub(crate) fn blocks_closest<K: Kernel>(
-    blocks: &[Tri4],
-    ids: &[u32],
-    ray: &Ray,
-    r: &RayLanes,
-    c: &mut Closest,
-) {
-    let mut b = 0;
-    while b < blocks.len() {
-        let (cand, n) = if b + 1 < blocks.len() {
-            (K::two(&blocks[b], &blocks[b + 1], r, c.tri_t_max), 2)
-        } else {
-            (K::one(&blocks[b], r, c.tri_t_max), 1)
-        };
-        if cand.mask != 0 {
-            c.take(
-                ray,
-                cand,
-                |l| blocks[b + l / LANES].vertices(l % LANES),
-                |l| ids[b * LANES + l],
-            );
-        }
-        b += n;
-    }
-}
-
-/// Whether a triangle of `blocks` has a hit before `t_max`.
-#[inline(always)]
-pub(crate) fn blocks_occluded<K: Kernel>(
-    blocks: &[Tri4],
-    ray: &Ray,
-    r: &RayLanes,
-    t_max: f32,
-) -> bool {
-    let mut b = 0;
-    while b < blocks.len() {
-        let (cand, n) = if b + 1 < blocks.len() {
-            (K::two(&blocks[b], &blocks[b + 1], r, t_max), 2)
-        } else {
-            (K::one(&blocks[b], r, t_max), 1)
-        };
-        if cand.mask != 0
-            && any_confirmed(ray, cand, t_max, |l| {
-                blocks[b + l / LANES].vertices(l % LANES)
-            })
-        {
-            return true;
-        }
-        b += n;
-    }
-    false
 }

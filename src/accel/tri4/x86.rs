@@ -1,212 +1,348 @@
-//! The SSE2 and AVX2 kernels: [`super::portable::candidates_portable`]'s operations, four or eight
-//! lanes at a time. Comparisons are ordered (false on NaN) like Rust's `<`, `>`, `==`.
+//! The SSE2 and AVX2 kernels: one template ([`watertight_lanes`]) instantiated with four-lane
+//! (`sse`) and eight-lane (`avx`) operations. Each step is [`intersect_watertight`]'s and
+//! [`t_error_bound`]'s, operation for operation and in their order, so an accepted lane's `t`
+//! and barycentrics are the scalar test's bits. Comparisons are ordered (false on NaN) like
+//! Rust's `<`, `>`, `==`; `max` is only applied to values that are never NaN in a lane that can
+//! be accepted, where it agrees with `f32::max`.
+//!
+//! [`intersect_watertight`]: crate::geometry::intersect_watertight
+//! [`t_error_bound`]: crate::geometry::t_error_bound
 
 use std::arch::x86_64::*;
 
-use super::{Candidates, LANES, RayLanes, Tri4};
+use super::{Hits, LANES, RayLanes, Tri4};
+use crate::geometry::gamma;
 
-/// [`super::portable::candidates_portable`] with SSE2.
-#[inline(always)]
-pub fn candidates_sse2(block: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
-    // SAFETY: SSE2 is part of every x86-64; the loads read whole `[f32; 4]` arrays.
-    unsafe {
+/// The watertight test of one ray against every lane of `$load`'s triangles, with the
+/// operations of module `$o` (`V` lanes wide, `FULL` the mask of all lanes): evaluates to
+/// `(mask, redo, t, b0, b1, b2)`.
+macro_rules! watertight_lanes {
+    ($o:ident, $load:expr, $r:expr, $t_max:expr) => {{
+        use $o::*;
+        let r: &RayLanes = $r;
+        let t_max: f32 = $t_max;
         let [kx, ky, kz] = r.axes;
-        let (ox, oy, oz) = (
-            _mm_set1_ps(r.origin[0]),
-            _mm_set1_ps(r.origin[1]),
-            _mm_set1_ps(r.origin[2]),
+        let (ox, oy, oz) = (splat(r.origin[0]), splat(r.origin[1]), splat(r.origin[2]));
+        let (sx, sy, sz) = (splat(r.shear[0]), splat(r.shear[1]), splat(r.shear[2]));
+        // `RayFrame`: the vertices relative to the origin, sheared.
+        let (a0, b0, z0) = (sub($load(0, kx), ox), sub($load(0, ky), oy), sub($load(0, kz), oz));
+        let (a1, b1, z1) = (sub($load(1, kx), ox), sub($load(1, ky), oy), sub($load(1, kz), oz));
+        let (a2, b2, z2) = (sub($load(2, kx), ox), sub($load(2, ky), oy), sub($load(2, kz), oz));
+        let (x0, y0) = (add(a0, mul(sx, z0)), add(b0, mul(sy, z0)));
+        let (x1, y1) = (add(a1, mul(sx, z1)), add(b1, mul(sy, z1)));
+        let (x2, y2) = (add(a2, mul(sx, z2)), add(b2, mul(sy, z2)));
+        // The edge functions (`RayFrame::edge_functions`), their products kept for the bound.
+        let (p12, p21) = (mul(x1, y2), mul(y1, x2));
+        let (p20, p02) = (mul(x2, y0), mul(y2, x0));
+        let (p01, p10) = (mul(x0, y1), mul(y0, x1));
+        let (e0, e1, e2) = (sub(p12, p21), sub(p20, p02), sub(p01, p10));
+        let zero = splat(0.0);
+        let any_zero = or(or(eq(e0, zero), eq(e1, zero)), eq(e2, zero));
+        let any_neg = or(or(lt(e0, zero), lt(e1, zero)), lt(e2, zero));
+        let any_pos = or(or(gt(e0, zero), gt(e1, zero)), gt(e2, zero));
+        let det = add(add(e0, e1), e2);
+        let (zs0, zs1, zs2) = (mul(sz, z0), mul(sz, z1), mul(sz, z2));
+        let t_scaled = add(add(mul(e0, zs0), mul(e1, zs1)), mul(e2, zs2));
+        let bound = mul(splat(t_max), det);
+        // Rejected as the scalar test rejects, in its order: mixed signs, a zero or NaN det,
+        // `t·det` outside (0, t_max·det] on det's side.
+        let reject = or(
+            or(and(any_neg, any_pos), or(eq(det, zero), unord(det, det))),
+            or(
+                and(lt(det, zero), or(ge(t_scaled, zero), lt(t_scaled, bound))),
+                and(gt(det, zero), or(le(t_scaled, zero), gt(t_scaled, bound))),
+            ),
         );
-        let (sx, sy, sz) = (
-            _mm_set1_ps(r.shear[0]),
-            _mm_set1_ps(r.shear[1]),
-            _mm_set1_ps(r.shear[2]),
-        );
-        let v = &block.v;
-        let sheared = |i: usize| {
-            let a = _mm_sub_ps(_mm_load_ps(v[i][kx].as_ptr()), ox);
-            let b = _mm_sub_ps(_mm_load_ps(v[i][ky].as_ptr()), oy);
-            let c = _mm_sub_ps(_mm_load_ps(v[i][kz].as_ptr()), oz);
+        let redo = mask(any_zero);
+        let pass = !mask(reject) & !redo & FULL;
+        if pass == 0 {
+            (0, redo, zero, zero, zero, zero)
+        } else {
+            let one = splat(1.0);
+            let inv_det = div(one, det);
+            let t = mul(t_scaled, inv_det);
+            let below = lt(t, splat(t_max));
+            // `t_error_bound`.
+            let (g2, g3, g5) = (splat(gamma(2)), splat(gamma(3)), splat(gamma(5)));
+            let two = splat(2.0);
+            let max_zt = max(max(abs(zs0), abs(zs1)), abs(zs2));
+            let (az0, az1, az2) = (abs(z0), abs(z1), abs(z2));
+            let (ax0, ax1, ax2) = (abs(x0), abs(x1), abs(x2));
+            let (ay0, ay1, ay2) = (abs(y0), abs(y1), abs(y2));
+            let dx0 = mul(g5, add(ax0, mul(two, abs(mul(sx, az0)))));
+            let dx1 = mul(g5, add(ax1, mul(two, abs(mul(sx, az1)))));
+            let dx2 = mul(g5, add(ax2, mul(two, abs(mul(sx, az2)))));
+            let dy0 = mul(g5, add(ay0, mul(two, abs(mul(sy, az0)))));
+            let dy1 = mul(g5, add(ay1, mul(two, abs(mul(sy, az1)))));
+            let dy2 = mul(g5, add(ay2, mul(two, abs(mul(sy, az2)))));
+            // `EdgeErrors::new`'s edge(j, k), for (1, 2), (2, 0), (0, 1).
+            let ee0 = add(
+                add(add(add(mul(ax1, dy2), mul(ay2, dx1)), mul(ay1, dx2)), mul(ax2, dy1)),
+                mul(g2, add(abs(p12), abs(p21))),
+            );
+            let ee1 = add(
+                add(add(add(mul(ax2, dy0), mul(ay0, dx2)), mul(ay2, dx0)), mul(ax0, dy2)),
+                mul(g2, add(abs(p20), abs(p02))),
+            );
+            let ee2 = add(
+                add(add(add(mul(ax0, dy1), mul(ay1, dx0)), mul(ay0, dx1)), mul(ax1, dy0)),
+                mul(g2, add(abs(p01), abs(p10))),
+            );
+            // `EdgeErrors::weights`.
+            let total = add(add(ee0, ee1), ee2);
+            let adet = abs(det);
+            let margin = sub(adet, total);
+            let certain = gt(margin, zero);
+            let inv = div(one, adet);
+            let g3z = mul(g3, max_zt);
+            let spread0 = add(abs(sub(zs0, t)), g3z);
+            let spread1 = add(abs(sub(zs1, t)), g3z);
+            let spread2 = add(abs(sub(zs2, t)), g3z);
+            let w0 = mul(add(ee0, mul(abs(mul(e0, inv)), total)), spread0);
+            let w1 = mul(add(ee1, mul(abs(mul(e1, inv)), total)), spread1);
+            let w2 = mul(add(ee2, mul(abs(mul(e2, inv)), total)), spread2);
+            let weights_error = div(add(add(w0, w1), w2), margin);
+            let delta_t = mul(
+                two,
+                add(
+                    add(mul(splat(2.0 * gamma(3)), max_zt), mul(g3, t)),
+                    weights_error,
+                ),
+            );
+            let beyond = gt(t, delta_t);
+            let hit = pass & mask(and(and(below, certain), beyond));
             (
-                _mm_add_ps(a, _mm_mul_ps(sx, c)),
-                _mm_add_ps(b, _mm_mul_ps(sy, c)),
-                c,
+                hit,
+                redo,
+                t,
+                mul(e0, inv_det),
+                mul(e1, inv_det),
+                mul(e2, inv_det),
             )
-        };
-        let (x0, y0, z0) = sheared(0);
-        let (x1, y1, z1) = sheared(1);
-        let (x2, y2, z2) = sheared(2);
-        let e0 = _mm_sub_ps(_mm_mul_ps(x1, y2), _mm_mul_ps(y1, x2));
-        let e1 = _mm_sub_ps(_mm_mul_ps(x2, y0), _mm_mul_ps(y2, x0));
-        let e2 = _mm_sub_ps(_mm_mul_ps(x0, y1), _mm_mul_ps(y0, x1));
-        let zero = _mm_setzero_ps();
-        let any_zero = _mm_or_ps(
-            _mm_or_ps(_mm_cmpeq_ps(e0, zero), _mm_cmpeq_ps(e1, zero)),
-            _mm_cmpeq_ps(e2, zero),
-        );
-        let any_neg = _mm_or_ps(
-            _mm_or_ps(_mm_cmplt_ps(e0, zero), _mm_cmplt_ps(e1, zero)),
-            _mm_cmplt_ps(e2, zero),
-        );
-        let any_pos = _mm_or_ps(
-            _mm_or_ps(_mm_cmpgt_ps(e0, zero), _mm_cmpgt_ps(e1, zero)),
-            _mm_cmpgt_ps(e2, zero),
-        );
-        let det = _mm_add_ps(_mm_add_ps(e0, e1), e2);
-        let t_scaled = _mm_add_ps(
-            _mm_add_ps(
-                _mm_mul_ps(e0, _mm_mul_ps(sz, z0)),
-                _mm_mul_ps(e1, _mm_mul_ps(sz, z1)),
-            ),
-            _mm_mul_ps(e2, _mm_mul_ps(sz, z2)),
-        );
-        let bound = _mm_mul_ps(_mm_set1_ps(t_max), det);
-        // Rejected as the scalar test rejects: mixed signs, a zero or NaN det, or t·det
-        // outside (0, t_max·det] (on det's side). A NaN t·det is not rejected here.
-        let reject = _mm_or_ps(
-            _mm_or_ps(
-                _mm_and_ps(any_neg, any_pos),
-                _mm_or_ps(_mm_cmpeq_ps(det, zero), _mm_cmpunord_ps(det, det)),
-            ),
-            _mm_or_ps(
-                _mm_and_ps(
-                    _mm_cmplt_ps(det, zero),
-                    _mm_or_ps(_mm_cmpge_ps(t_scaled, zero), _mm_cmplt_ps(t_scaled, bound)),
-                ),
-                _mm_and_ps(
-                    _mm_cmpgt_ps(det, zero),
-                    _mm_or_ps(_mm_cmple_ps(t_scaled, zero), _mm_cmpgt_ps(t_scaled, bound)),
-                ),
-            ),
-        );
-        let mask = (!_mm_movemask_ps(reject) as u32 & 0xf) | _mm_movemask_ps(any_zero) as u32;
-        let mut out = Candidates {
-            mask,
-            t: [0.0; 2 * LANES],
-        };
-        if mask != 0 {
-            let mut ts = [0f32; LANES];
-            let mut d = [0f32; LANES];
-            _mm_storeu_ps(ts.as_mut_ptr(), t_scaled);
-            _mm_storeu_ps(d.as_mut_ptr(), det);
-            let zero_mask = _mm_movemask_ps(any_zero) as u32;
-            out.fill_t(mask, zero_mask, &ts, &d, 0);
         }
-        out
+    }};
+}
+
+/// Four lanes of SSE2, under the names [`watertight_lanes`] uses. SAFETY (of every `unsafe`
+/// here): SSE2 is part of every x86-64 CPU; these take and return registers only.
+mod sse {
+    use std::arch::x86_64::*;
+
+    pub type V = __m128;
+    pub const FULL: u32 = 0xf;
+
+    #[inline(always)]
+    pub fn splat(x: f32) -> V {
+        unsafe { _mm_set1_ps(x) }
+    }
+    #[inline(always)]
+    pub fn add(a: V, b: V) -> V {
+        unsafe { _mm_add_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn sub(a: V, b: V) -> V {
+        unsafe { _mm_sub_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn mul(a: V, b: V) -> V {
+        unsafe { _mm_mul_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn div(a: V, b: V) -> V {
+        unsafe { _mm_div_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn abs(a: V) -> V {
+        unsafe { _mm_andnot_ps(_mm_set1_ps(-0.0), a) }
+    }
+    /// `f32::max` where neither is NaN.
+    #[inline(always)]
+    pub fn max(a: V, b: V) -> V {
+        unsafe { _mm_max_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn and(a: V, b: V) -> V {
+        unsafe { _mm_and_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn or(a: V, b: V) -> V {
+        unsafe { _mm_or_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn eq(a: V, b: V) -> V {
+        unsafe { _mm_cmpeq_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn lt(a: V, b: V) -> V {
+        unsafe { _mm_cmplt_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn le(a: V, b: V) -> V {
+        unsafe { _mm_cmple_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn gt(a: V, b: V) -> V {
+        unsafe { _mm_cmpgt_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn ge(a: V, b: V) -> V {
+        unsafe { _mm_cmpge_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn unord(a: V, b: V) -> V {
+        unsafe { _mm_cmpunord_ps(a, b) }
+    }
+    #[inline(always)]
+    pub fn mask(a: V) -> u32 {
+        unsafe { _mm_movemask_ps(a) as u32 }
     }
 }
 
-/// Two blocks with SSE2, one after the other.
+/// Eight lanes of AVX, under the names [`watertight_lanes`] uses. Compiled for AVX2 (the path's
+/// feature), so they inline into the AVX2 kernels.
+mod avx {
+    use std::arch::x86_64::*;
+
+    pub type V = __m256;
+    pub const FULL: u32 = 0xff;
+
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn splat(x: f32) -> V {
+        _mm256_set1_ps(x)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn add(a: V, b: V) -> V {
+        _mm256_add_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn sub(a: V, b: V) -> V {
+        _mm256_sub_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn mul(a: V, b: V) -> V {
+        _mm256_mul_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn div(a: V, b: V) -> V {
+        _mm256_div_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn abs(a: V) -> V {
+        _mm256_andnot_ps(_mm256_set1_ps(-0.0), a)
+    }
+    /// `f32::max` where neither is NaN.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn max(a: V, b: V) -> V {
+        _mm256_max_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn and(a: V, b: V) -> V {
+        _mm256_and_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn or(a: V, b: V) -> V {
+        _mm256_or_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn eq(a: V, b: V) -> V {
+        _mm256_cmp_ps::<_CMP_EQ_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn lt(a: V, b: V) -> V {
+        _mm256_cmp_ps::<_CMP_LT_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn le(a: V, b: V) -> V {
+        _mm256_cmp_ps::<_CMP_LE_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn gt(a: V, b: V) -> V {
+        _mm256_cmp_ps::<_CMP_GT_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn ge(a: V, b: V) -> V {
+        _mm256_cmp_ps::<_CMP_GE_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn unord(a: V, b: V) -> V {
+        _mm256_cmp_ps::<_CMP_UNORD_Q>(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn mask(a: V) -> u32 {
+        _mm256_movemask_ps(a) as u32
+    }
+}
+
+/// The hits of one block with SSE2 (four lanes).
 #[inline(always)]
-pub fn candidates2_sse2(a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
-    let (ca, cb) = (candidates_sse2(a, r, t_max), candidates_sse2(b, r, t_max));
-    let mut t = ca.t;
-    t[LANES..].copy_from_slice(&cb.t[..LANES]);
-    Candidates {
-        mask: ca.mask | cb.mask << LANES,
-        t,
+pub fn hits_sse2(block: &Tri4, r: &RayLanes, t_max: f32) -> Hits {
+    let v = &block.v;
+    // SAFETY: SSE2 is part of every x86-64; each load reads a whole aligned `[f32; 4]`.
+    let load = |i: usize, axis: usize| unsafe { _mm_load_ps(v[i][axis].as_ptr()) };
+    let (mask, redo, t, b0, b1, b2) = watertight_lanes!(sse, load, r, t_max);
+    let mut out = Hits { redo, ..Hits::NONE };
+    if mask != 0 {
+        out.mask = mask;
+        // SAFETY: each store writes the first four of eight `f32`s.
+        unsafe {
+            _mm_storeu_ps(out.t.as_mut_ptr(), t);
+            _mm_storeu_ps(out.b[0].as_mut_ptr(), b0);
+            _mm_storeu_ps(out.b[1].as_mut_ptr(), b1);
+            _mm_storeu_ps(out.b[2].as_mut_ptr(), b2);
+        }
     }
+    out
 }
 
-/// Two blocks at once with AVX2: lanes 0-3 from `a`, 4-7 from `b`.
+/// The hits of two blocks at once with AVX2: lanes 0-3 from `a`, 4-7 from `b`.
 ///
 /// # Safety
 /// The CPU must have AVX2 ([`super::Isa::Avx2`] available).
 #[target_feature(enable = "avx2")]
 #[inline]
-pub unsafe fn candidates2_avx2(a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
-    // SAFETY (of the loads): each reads a whole `[f32; 4]`, 16-byte aligned.
-    unsafe {
-        let [kx, ky, kz] = r.axes;
-        let load = |i: usize, axis: usize| {
+pub unsafe fn hits2_avx2(a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Hits {
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn load2(a: &Tri4, b: &Tri4, i: usize, axis: usize) -> __m256 {
+        // SAFETY: each load reads a whole `[f32; 4]`, 16-byte aligned.
+        unsafe {
             _mm256_insertf128_ps(
                 _mm256_castps128_ps256(_mm_load_ps(a.v[i][axis].as_ptr())),
                 _mm_load_ps(b.v[i][axis].as_ptr()),
                 1,
             )
-        };
-        let (ox, oy, oz) = (
-            _mm256_set1_ps(r.origin[0]),
-            _mm256_set1_ps(r.origin[1]),
-            _mm256_set1_ps(r.origin[2]),
-        );
-        let (sx, sy, sz) = (
-            _mm256_set1_ps(r.shear[0]),
-            _mm256_set1_ps(r.shear[1]),
-            _mm256_set1_ps(r.shear[2]),
-        );
-        let sheared = |i: usize| {
-            let p = _mm256_sub_ps(load(i, kx), ox);
-            let q = _mm256_sub_ps(load(i, ky), oy);
-            let c = _mm256_sub_ps(load(i, kz), oz);
-            (
-                _mm256_add_ps(p, _mm256_mul_ps(sx, c)),
-                _mm256_add_ps(q, _mm256_mul_ps(sy, c)),
-                c,
-            )
-        };
-        let (x0, y0, z0) = sheared(0);
-        let (x1, y1, z1) = sheared(1);
-        let (x2, y2, z2) = sheared(2);
-        let e0 = _mm256_sub_ps(_mm256_mul_ps(x1, y2), _mm256_mul_ps(y1, x2));
-        let e1 = _mm256_sub_ps(_mm256_mul_ps(x2, y0), _mm256_mul_ps(y2, x0));
-        let e2 = _mm256_sub_ps(_mm256_mul_ps(x0, y1), _mm256_mul_ps(y0, x1));
-        let zero = _mm256_setzero_ps();
-        let cmp3 = |f: fn(__m256, __m256) -> __m256| {
-            _mm256_or_ps(_mm256_or_ps(f(e0, zero), f(e1, zero)), f(e2, zero))
-        };
-        let any_zero = cmp3(|a, b| _mm256_cmp_ps::<_CMP_EQ_OQ>(a, b));
-        let any_neg = cmp3(|a, b| _mm256_cmp_ps::<_CMP_LT_OQ>(a, b));
-        let any_pos = cmp3(|a, b| _mm256_cmp_ps::<_CMP_GT_OQ>(a, b));
-        let det = _mm256_add_ps(_mm256_add_ps(e0, e1), e2);
-        let t_scaled = _mm256_add_ps(
-            _mm256_add_ps(
-                _mm256_mul_ps(e0, _mm256_mul_ps(sz, z0)),
-                _mm256_mul_ps(e1, _mm256_mul_ps(sz, z1)),
-            ),
-            _mm256_mul_ps(e2, _mm256_mul_ps(sz, z2)),
-        );
-        let bound = _mm256_mul_ps(_mm256_set1_ps(t_max), det);
-        let reject = _mm256_or_ps(
-            _mm256_or_ps(
-                _mm256_and_ps(any_neg, any_pos),
-                _mm256_or_ps(
-                    _mm256_cmp_ps::<_CMP_EQ_OQ>(det, zero),
-                    _mm256_cmp_ps::<_CMP_UNORD_Q>(det, det),
-                ),
-            ),
-            _mm256_or_ps(
-                _mm256_and_ps(
-                    _mm256_cmp_ps::<_CMP_LT_OQ>(det, zero),
-                    _mm256_or_ps(
-                        _mm256_cmp_ps::<_CMP_GE_OQ>(t_scaled, zero),
-                        _mm256_cmp_ps::<_CMP_LT_OQ>(t_scaled, bound),
-                    ),
-                ),
-                _mm256_and_ps(
-                    _mm256_cmp_ps::<_CMP_GT_OQ>(det, zero),
-                    _mm256_or_ps(
-                        _mm256_cmp_ps::<_CMP_LE_OQ>(t_scaled, zero),
-                        _mm256_cmp_ps::<_CMP_GT_OQ>(t_scaled, bound),
-                    ),
-                ),
-            ),
-        );
-        let mask =
-            (!_mm256_movemask_ps(reject) as u32 & 0xff) | _mm256_movemask_ps(any_zero) as u32;
-        let mut out = Candidates {
-            mask,
-            t: [0.0; 2 * LANES],
-        };
-        if mask != 0 {
-            let mut ts = [0f32; 2 * LANES];
-            let mut d = [0f32; 2 * LANES];
-            _mm256_storeu_ps(ts.as_mut_ptr(), t_scaled);
-            _mm256_storeu_ps(d.as_mut_ptr(), det);
-            let zero_mask = _mm256_movemask_ps(any_zero) as u32;
-            out.fill_t(mask, zero_mask, &ts, &d, 0);
         }
-        out
     }
+    let load = |i: usize, axis: usize| load2(a, b, i, axis);
+    let (mask, redo, t, b0, b1, b2) = watertight_lanes!(avx, load, r, t_max);
+    let mut out = Hits { redo, ..Hits::NONE };
+    if mask != 0 {
+        out.mask = mask;
+        // SAFETY: each store writes eight `f32`s.
+        unsafe {
+            _mm256_storeu_ps(out.t.as_mut_ptr(), t);
+            _mm256_storeu_ps(out.b[0].as_mut_ptr(), b0);
+            _mm256_storeu_ps(out.b[1].as_mut_ptr(), b1);
+            _mm256_storeu_ps(out.b[2].as_mut_ptr(), b2);
+        }
+    }
+    out
 }
 
 /// One block on the AVX2 path: the SSE2 kernel (VEX-encoded in this context).
@@ -215,6 +351,8 @@ pub unsafe fn candidates2_avx2(a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> 
 /// The CPU must have AVX2.
 #[target_feature(enable = "avx2")]
 #[inline]
-pub unsafe fn candidates_avx2(block: &Tri4, r: &RayLanes, t_max: f32) -> Candidates {
-    candidates_sse2(block, r, t_max)
+pub unsafe fn hits_avx2(block: &Tri4, r: &RayLanes, t_max: f32) -> Hits {
+    hits_sse2(block, r, t_max)
 }
+
+const _: () = assert!(LANES == 4);

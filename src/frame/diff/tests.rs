@@ -202,3 +202,117 @@ fn diff_of_identical_frames_is_empty() {
     encode_diff(None, &g, 0, &mut out);
     assert!(out.starts_with(b"\x1b[1;1H"));
 }
+
+/// A seeded xorshift generator for the random grids.
+struct Seeded(u64);
+
+impl Seeded {
+    fn below(&mut self, n: u64) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0 % n
+    }
+
+    /// One of 216 colours near each other (6 levels apart), so tolerances matter.
+    fn colour(&mut self) -> Colour {
+        let mut v = || 100 + 6 * self.below(6) as u8;
+        Colour::Rgb(v(), v(), v())
+    }
+
+    /// A block cell (a third of them of one colour), or now and then text.
+    fn cell(&mut self) -> Cell {
+        if self.below(16) == 0 {
+            Cell {
+                ch: 'x',
+                fg: Some(self.colour()),
+                bg: Some(self.colour()),
+            }
+        } else {
+            let up = self.colour();
+            let lo = if self.below(3) == 0 {
+                up
+            } else {
+                self.colour()
+            };
+            block(up, lo)
+        }
+    }
+}
+
+#[test]
+fn diffs_within_limits_leave_the_screen_as_the_encoder_believes_and_reach_the_frame() {
+    let mut rng = Seeded(0x2545_f491_4f6c_dd1d);
+    for case in 0..300 {
+        let cols = 1 + rng.below(20) as usize;
+        let rows = 1 + rng.below(6) as usize;
+        let prev = grid((0..cols * rows).map(|_| rng.cell()).collect(), cols);
+        let next = grid((0..cols * rows).map(|_| rng.cell()).collect(), cols);
+        let mut terminal = prev.clone();
+        let mut shown = Some(prev.clone());
+        // Frames cut short by random budgets and tolerances, then exact ones, until done.
+        for frame in 0.. {
+            assert!(frame < 200, "case {case}: never reached the frame");
+            let limits = DiffLimits {
+                tolerance: if frame < 3 {
+                    [0, 8, 16][rng.below(3) as usize]
+                } else {
+                    0
+                },
+                max_bytes: 1 + rng.below(400) as usize,
+                first_row: rng.below(rows as u64) as usize,
+            };
+            let mut out = Vec::new();
+            let outcome = encode_diff_within(&mut shown, &next, 0, limits, &mut out);
+            apply(&mut terminal, &out);
+            let believed = shown.as_ref().expect("a screen");
+            assert_eq!(
+                looks(&terminal),
+                looks(believed),
+                "case {case} frame {frame}"
+            );
+            let worst = (believed.cells.iter().zip(&next.cells))
+                .map(|(a, b)| distance(a, b))
+                .max()
+                .unwrap_or(0);
+            if outcome.complete {
+                assert!(worst <= u16::from(limits.tolerance), "case {case}");
+                assert_eq!(outcome.max_error, worst, "case {case}");
+                if worst == 0 {
+                    assert_eq!(looks(&terminal), looks(&next), "case {case}");
+                    break;
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn an_exact_diff_sends_each_pair_of_colours_once_wherever_its_cells_are() {
+    // Two colour pairs in a checkerboard over two rows: in reading order every cell would need
+    // a new pair; sent by shared colours, each pair is set once (▀ and ▄ turn it round).
+    let (a, b, c, d) = (
+        Colour::Rgb(200, 10, 10),
+        Colour::Rgb(10, 200, 10),
+        Colour::Rgb(10, 10, 200),
+        Colour::Rgb(100, 100, 100),
+    );
+    let cells = (0..16)
+        .map(|i| match (i + i / 8) % 4 {
+            0 => block(a, b),
+            1 => block(c, d),
+            2 => block(b, a),
+            _ => block(d, c),
+        })
+        .collect();
+    let next = grid(cells, 8);
+    let prev = grid(vec![block(a, a); 16], 8);
+    let out = round_trip(&prev, &next);
+    let sgrs = String::from_utf8_lossy(&out).matches('m').count();
+    // One SGR for a/b, one for c/d, and the reset at the end.
+    assert!(
+        sgrs <= 3,
+        "{sgrs} SGRs: {:?}",
+        String::from_utf8_lossy(&out)
+    );
+}

@@ -1,0 +1,128 @@
+//! The block loops every structure shares: the closest hit among blocks, and whether any block
+//! is hit.
+
+use glam::Vec3;
+
+use super::{Hits, Kernel, LANES, RayLanes, Tri4};
+use crate::accel::hit::{Hit, shrunk_t_max};
+use crate::geometry::{Ray, intersect_watertight};
+
+/// The closest-hit search's state: the best hit so far and the `t_max` a triangle is tested
+/// with (four ULPs above it, see [`shrunk_t_max`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Closest {
+    pub best: Option<Hit>,
+    pub tri_t_max: f32,
+    pub t_max: f32,
+}
+
+impl Closest {
+    #[inline(always)]
+    pub fn new(t_max: f32) -> Closest {
+        Closest {
+            best: None,
+            tri_t_max: t_max,
+            t_max,
+        }
+    }
+
+    /// Keeps the hit `(t, b)` on triangle `i` if it beats the best: a smaller `t`, or the same
+    /// `t` on a lower index.
+    #[inline(always)]
+    fn offer(&mut self, t: f32, b: [f32; 3], i: u32) {
+        if self
+            .best
+            .is_none_or(|h| t < h.t || t == h.t && i < h.triangle)
+        {
+            self.best = Some(Hit { t, b, triangle: i });
+            self.tri_t_max = shrunk_t_max(t, self.t_max);
+        }
+    }
+
+    /// Folds a kernel's hits into the best: its hit lanes as they are, its `redo` lanes through
+    /// the scalar test. `vertices(lane)` and `id(lane)` give a lane's triangle.
+    #[inline(always)]
+    pub fn take(
+        &mut self,
+        ray: &Ray,
+        h: &Hits,
+        vertices: impl Fn(usize) -> [Vec3; 3],
+        id: impl Fn(usize) -> u32,
+    ) {
+        let mut m = h.mask;
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            self.offer(h.t[l], [h.b[0][l], h.b[1][l], h.b[2][l]], id(l));
+        }
+        let mut m = h.redo;
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            if let Some(s) = intersect_watertight(ray, &vertices(l), self.tri_t_max) {
+                self.offer(s.t, s.b, id(l));
+            }
+        }
+    }
+}
+
+/// Folds the closest hit among consecutive `blocks` (whose lanes' scene indices are `ids`) into
+/// `c`: two blocks per step where there are two.
+#[inline(always)]
+pub(crate) fn blocks_closest<K: Kernel>(
+    blocks: &[Tri4],
+    ids: &[u32],
+    ray: &Ray,
+    r: &RayLanes,
+    c: &mut Closest,
+) {
+    let mut b = 0;
+    while b < blocks.len() {
+        let (h, n) = if b + 1 < blocks.len() {
+            (K::two(&blocks[b], &blocks[b + 1], ray, r, c.tri_t_max), 2)
+        } else {
+            (K::one(&blocks[b], ray, r, c.tri_t_max), 1)
+        };
+        if (h.mask | h.redo) != 0 {
+            c.take(
+                ray,
+                &h,
+                |l| blocks[b + l / LANES].vertices(l % LANES),
+                |l| ids[b * LANES + l],
+            );
+        }
+        b += n;
+    }
+}
+
+/// Whether a triangle of `blocks` has a hit before `t_max`.
+#[inline(always)]
+pub(crate) fn blocks_occluded<K: Kernel>(
+    blocks: &[Tri4],
+    ray: &Ray,
+    r: &RayLanes,
+    t_max: f32,
+) -> bool {
+    let mut b = 0;
+    while b < blocks.len() {
+        let (h, n) = if b + 1 < blocks.len() {
+            (K::two(&blocks[b], &blocks[b + 1], ray, r, t_max), 2)
+        } else {
+            (K::one(&blocks[b], ray, r, t_max), 1)
+        };
+        if h.mask != 0 {
+            return true;
+        }
+        let mut m = h.redo;
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let v = blocks[b + l / LANES].vertices(l % LANES);
+            if intersect_watertight(ray, &v, t_max).is_some() {
+                return true;
+            }
+        }
+        b += n;
+    }
+    false
+}
