@@ -103,7 +103,8 @@ pub fn encode_diff(prev: Option<&CellGrid>, next: &CellGrid, top: usize, out: &m
 
 /// Like [`encode_diff`], within `limits`, updating `shown` (what the screen shows; `None` or
 /// another size: unknown, so every cell is sent) to what it shows afterwards. Cells within the
-/// tolerance are left as they are; a block cell that is sent is sent within it ([`quantize`]d).
+/// tolerance are left as they are; a block cell that is sent is sent within it (each channel
+/// rounded to a multiple of 2·tolerance + 1, so that nearby cells share colours).
 pub fn encode_diff_within(
     shown: &mut Option<CellGrid>,
     next: &CellGrid,
