@@ -354,3 +354,28 @@ fn leaves_hold_a_few_triangles() {
 fn million_triangle_icosphere_matches_brute_force() {
     assert_exact(displaced_icosphere(224, 0.08), 41, 300, 2.0);
 }
+
+#[test]
+fn wide_nodes_of_every_fill_match_brute_force() {
+    // Traversal reads the binary tree collapsed into nodes of up to eight children. Meshes
+    // from a single leaf up to a few thousand triangles give roots and nodes with every number
+    // of children and leaves of every size; each must answer as the loop does.
+    for n in [1, 2, 9, 17, 40, 64, 100, 300, 1_000, 4_000] {
+        let tris = soup(40 + n as u64, n, 1.0, 0.3, 1.0);
+        let s = scene_of(tris.clone(), AccelKind::Bvh);
+        assert_exact(tris.clone(), 41 + n as u64, 400, 1.5);
+        let all: Vec<Triangle> = tris
+            .iter()
+            .map(|v| Triangle::new(v[0], v[1], v[2], 0).unwrap())
+            .collect();
+        let bvh = Bvh::build(&all);
+        assert!(
+            bvh.wide_nodes() <= bvh.nodes() / 2,
+            "{n} triangles: {} wide nodes for {} binary",
+            bvh.wide_nodes(),
+            bvh.nodes()
+        );
+        assert!(bvh.wide_depth() < bvh.depth().max(1), "{n} triangles");
+        assert_eq!(s.accel_stats().nodes, bvh.nodes());
+    }
+}

@@ -13,6 +13,7 @@ use common::{Rng, in_cube, log_uniform, uniform, unit};
 use glam::Vec3;
 use raytty::accel::Isa;
 use raytty::accel::box4::Box4;
+use raytty::accel::box8::Box8;
 use raytty::accel::tri4::{Hits, Tri4, hits as hits_in, hits2};
 use raytty::geometry::{Aabb, TriHit, intersect_watertight};
 use raytty::scene::procedural::displaced_icosphere;
@@ -401,6 +402,53 @@ fn box_tests_agree_on_every_path() {
                 }
             }
             let _ = t;
+        }
+    }
+}
+
+#[test]
+fn wide_box_tests_agree_on_every_path() {
+    // The wide BVH's eight boxes at once (`Box8`): every path against `Aabb::enter`, hit and
+    // entry `t` bit for bit, with axis-parallel rays whose origins lie on slab planes (the NaN
+    // cases) and boxes that share those planes.
+    let mut rng = Rng::seeded(8);
+    for i in 0..20_000 {
+        let boxes: Vec<Aabb> = (0..8)
+            .map(|_| {
+                let lo = in_cube(&mut rng, 1.0);
+                let size = in_cube(&mut rng, 1.0).abs();
+                Aabb {
+                    min: lo,
+                    max: lo + size,
+                }
+            })
+            .collect();
+        let b = Box8::new(&boxes);
+        let mut origin = in_cube(&mut rng, 2.0);
+        let mut dir = in_cube(&mut rng, 1.0);
+        if i % 3 == 0 {
+            let axis = i % 9 / 3;
+            dir[axis] = if i % 6 == 0 { 0.0 } else { -0.0 };
+            origin[axis] = if i % 2 == 0 {
+                boxes[i % 8].min[axis]
+            } else {
+                boxes[(i + 5) % 8].max[axis]
+            };
+        }
+        if dir == Vec3::ZERO {
+            continue;
+        }
+        let ray = Ray::new(origin, dir);
+        let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
+        for t_max in [f32::INFINITY, uniform(&mut rng, 0.0, 3.0)] {
+            for isa in paths() {
+                let (mask, t) = b.enter(isa, &o, &inv, t_max);
+                for (l, bx) in boxes.iter().enumerate() {
+                    let want = bx.enter(&ray, t_max).map(f32::to_bits);
+                    let got = (mask & 1 << l != 0).then_some(t[l].to_bits());
+                    assert_eq!(got, want, "{isa:?} lane {l}: {ray:?} {bx:?} {t_max}");
+                }
+            }
         }
     }
 }

@@ -1,7 +1,7 @@
 //! A bounding volume hierarchy over a scene's triangles: binned SAH, built in parallel
-//! (`bvh/build.rs`), stored as 32-byte nodes in sibling pairs (one 64-byte cache line, boxes laid out
-//! slab by slab so both children are tested at once) in depth-first order, traversed
-//! iteratively with a fixed stack.
+//! (`bvh/build.rs`) as a binary tree, then collapsed into nodes of up to eight children
+//! (`bvh/wide.rs`) whose boxes are slab-tested eight at once, visited nearest entry first with a
+//! fixed stack.
 //!
 //! The triangles' vertices are copied in leaf order, so a leaf's triangles sit next to each
 //! other in memory; each keeps its index in the scene, which is what a [`Hit`] reports.
@@ -10,7 +10,7 @@
 //!
 //! [`Bvh::intersect`] returns exactly what a loop over all triangles would: the hit with the
 //! smallest `t`, and among hits at the same `t` the one with the lowest scene index, each hit
-//! as [`intersect_watertight`] computes it for the query's `t_max`. [`Bvh::occluded`] is true
+//! as [`intersect_watertight`](crate::geometry::intersect_watertight) computes it for the query's `t_max`. [`Bvh::occluded`] is true
 //! exactly when one triangle has such a hit. Only two things could make a traversal differ:
 //!
 //! - A box is skipped only when the ray reaches it beyond [`cull_bound`](super::cull_bound) of the best hit so
@@ -19,11 +19,14 @@
 //! - A triangle is tested with `t_max` shrunk to the best hit so far, widened by a few ULPs
 //!   ([`shrunk_t_max`](super::shrunk_t_max)), so a hit that ties the best one is still reported and the tie is
 //!   broken by index.
+//!
+//! The order in which children are visited changes neither.
 
 mod build;
 mod node;
+mod wide;
 
-use rayon::prelude::*;
+use std::mem::MaybeUninit;
 
 use super::hit::{Hit, cull_bound};
 use super::isa::Isa;
@@ -33,26 +36,38 @@ use super::tri4::{
     Closest, Kernel, LANES, Portable, RayLanes, Tri4, blocks_closest, blocks_occluded,
 };
 use crate::geometry::{Ray, Triangle};
-use node::{Node, NodePair, Pair};
+use node::{Node, NodePair};
+use wide::{LEAF, TreeStats, WIDTH, Wide, WideBoxes, leaf_blocks};
 
 pub use build::{LEAF_MAX, SAH_BINS};
 
-/// Most levels a hierarchy has (root = level 1); the builder keeps to it by switching from SAH to
-/// median splits deep down, so traversal can use a fixed stack.
+/// Most levels the binary tree has (root = level 1); the builder keeps to it by switching from
+/// SAH to median splits deep down. The wide tree has no more levels than the binary one, so
+/// traversal can use a fixed stack.
 pub const MAX_DEPTH: usize = 64;
+
+/// Entries a traversal stack needs: a node pushes at most all its children but one it visits
+/// at once, on each of at most [`MAX_DEPTH`] levels.
+const STACK: usize = (WIDTH - 1) * MAX_DEPTH + 1;
 
 /// A bounding volume hierarchy over a list of triangles.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Bvh {
-    /// Sibling pairs in depth-first order; the root alone in the first. Node `i` is lane
-    /// `i % 2` of pair `i / 2`.
-    nodes: Vec<Pair>,
+    /// Wide nodes in depth-first order (the root first, unless the tree is one leaf).
+    nodes: Vec<Wide>,
+    /// The root: a node index, or a leaf when the tree is one leaf.
+    root: u32,
     /// Each leaf's triangles in [`Tri4`] blocks (the last one padded), leaves in depth-first
-    /// order; a leaf's [`Node::offset`] is its first block.
+    /// order.
     blocks: Vec<Tri4>,
     /// Scene index of each lane of `blocks` (`u32::MAX` for padding).
     ids: Vec<u32>,
+    /// Levels of the binary tree.
     depth: u32,
+    /// Levels of wide nodes.
+    wide_depth: u32,
+    /// The binary tree's figures.
+    tree: TreeStats,
 }
 
 impl Bvh {
@@ -64,81 +79,50 @@ impl Bvh {
             "a BVH holds at most 2³² − 1 triangles"
         );
         let built = build::build(triangles);
-        let mut nodes: Vec<Pair> = built.pairs.into_par_iter().map(Pair::new).collect();
-        let leaves = |p: &Pair| (0..2).filter(|&l| p.count[l] > 0).count();
-        let n_blocks: usize = nodes
-            .iter()
-            .flat_map(|p| (0..2).map(|l| (p.count[l] as usize).div_ceil(LANES)))
-            .sum();
-        let mut blocks = Vec::with_capacity(n_blocks);
-        let mut ids = Vec::with_capacity(n_blocks * LANES);
-        for p in nodes.iter_mut().filter(|p| leaves(p) > 0) {
-            for lane in 0..2 {
-                let (offset, count) = (p.offset[lane] as usize, p.count[lane] as usize);
-                if count == 0 {
-                    continue;
-                }
-                let leaf = &built.order[offset..offset + count];
-                p.offset[lane] = u32::try_from(blocks.len()).expect("fewer than 2³² blocks");
-                blocks.extend(Tri4::pack(leaf.iter().map(|&i| triangles[i as usize].v)));
-                ids.extend_from_slice(leaf);
-                ids.resize(blocks.len() * LANES, u32::MAX);
-            }
-        }
+        let tree = TreeStats::of(&built.pairs);
+        let c = wide::collapse(&built.pairs, &built.order, triangles);
         Bvh {
-            nodes,
-            blocks,
-            ids,
+            nodes: c.nodes,
+            root: c.root,
+            blocks: c.blocks,
+            ids: c.ids,
             depth: built.depth,
+            wide_depth: c.depth,
+            tree,
         }
     }
 
-    /// Number of nodes.
+    /// Number of nodes of the binary SAH tree it was built as (traversal reads it collapsed
+    /// into [`Bvh::wide_nodes`]).
     pub fn nodes(&self) -> usize {
-        (2 * self.nodes.len()).saturating_sub(1)
+        self.tree.nodes
     }
 
-    /// Every node (the root, then the pairs; not the root pair's filler).
-    fn all_nodes(&self) -> impl Iterator<Item = Node> {
-        self.nodes
-            .iter()
-            .flat_map(|p| [p.node(0), p.node(1)])
-            .enumerate()
-            .filter(|&(i, _)| i != 1)
-            .map(|(_, n)| n)
-    }
-
-    /// Number of levels (0 when empty, 1 for a single leaf).
+    /// Number of levels of the binary SAH tree (0 when empty, 1 for a single leaf).
     pub fn depth(&self) -> u32 {
         self.depth
     }
 
-    /// The tree's SAH cost: the expected number of box-pair and triangle tests for a random
-    /// ray that meets the root box (each node weighted by its area over the root's). Lower is
-    /// better; compare builds of one scene with it.
-    pub fn sah_cost(&self) -> f64 {
-        let area = |n: &Node| {
-            let d = (n.max - n.min).as_dvec3();
-            2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
-        };
-        let Some(root) = self.nodes.first().map(|p| p.node(0)) else {
-            return 0.0;
-        };
-        let root_area = area(&root);
-        if !(root_area > 0.0) {
-            return 0.0;
-        }
-        self.all_nodes()
-            .map(|n| {
-                let work = if n.is_leaf() { f64::from(n.count) } else { 1.0 };
-                work * area(&n) / root_area
-            })
-            .sum()
+    /// Number of wide nodes (of up to eight children) traversal reads.
+    pub fn wide_nodes(&self) -> usize {
+        self.nodes.len()
     }
 
-    /// Number of leaves.
+    /// Levels of wide nodes above the leaves (0 for a single leaf or none).
+    pub fn wide_depth(&self) -> u32 {
+        self.wide_depth
+    }
+
+    /// The binary tree's SAH cost: the expected number of box-pair and triangle tests for a
+    /// random ray that meets the root box (each node weighted by its area over the root's).
+    /// Lower is better; compare builds of one scene with it.
+    pub fn sah_cost(&self) -> f64 {
+        self.tree.sah_cost
+    }
+
+    /// Number of leaves (the same in the binary and the wide tree).
     pub fn leaves(&self) -> usize {
-        self.all_nodes().filter(|n| n.is_leaf()).count()
+        self.tree.leaves
     }
 
     /// The closest hit with `t < t_max` (ties go to the lowest scene index), or `None`, on
@@ -156,9 +140,22 @@ impl Bvh {
     /// [`Bvh::intersect`] on path `isa`, which must be available.
     pub fn intersect_on(&self, isa: Isa, ray: &Ray, t_max: f32) -> Option<Hit> {
         assert!(isa.available(), "{} is not available", isa.name());
+        self.intersect_isa(isa, ray, t_max)
+    }
+
+    /// [`Bvh::occluded`] on path `isa`, which must be available.
+    pub fn occluded_on(&self, isa: Isa, ray: &Ray, t_max: f32) -> bool {
+        assert!(isa.available(), "{} is not available", isa.name());
+        self.occluded_isa(isa, ray, t_max)
+    }
+
+    /// [`Bvh::intersect_on`] for a caller that knows `isa` is available.
+    #[inline]
+    pub(super) fn intersect_isa(&self, isa: Isa, ray: &Ray, t_max: f32) -> Option<Hit> {
+        debug_assert!(isa.available(), "{} is not available", isa.name());
         match isa {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: checked available above.
+            // SAFETY: the caller passes an available path.
             Isa::Avx2 => unsafe { closest_avx2(self, ray, t_max) },
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => self.closest::<Sse2>(ray, t_max),
@@ -166,12 +163,13 @@ impl Bvh {
         }
     }
 
-    /// [`Bvh::occluded`] on path `isa`, which must be available.
-    pub fn occluded_on(&self, isa: Isa, ray: &Ray, t_max: f32) -> bool {
-        assert!(isa.available(), "{} is not available", isa.name());
+    /// [`Bvh::occluded_on`] for a caller that knows `isa` is available.
+    #[inline]
+    pub(super) fn occluded_isa(&self, isa: Isa, ray: &Ray, t_max: f32) -> bool {
+        debug_assert!(isa.available(), "{} is not available", isa.name());
         match isa {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: checked available above.
+            // SAFETY: the caller passes an available path.
             Isa::Avx2 => unsafe { occluded_avx2(self, ray, t_max) },
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => self.any::<Sse2>(ray, t_max),
@@ -181,55 +179,69 @@ impl Bvh {
 
     /// A leaf's blocks and their lanes' scene indices.
     #[inline(always)]
-    fn leaf(&self, offset: usize, count: usize) -> (&[Tri4], &[u32]) {
-        let end = offset + count.div_ceil(LANES);
+    fn leaf(&self, r: u32) -> (&[Tri4], &[u32]) {
+        let (first, count) = leaf_blocks(r);
+        let end = first + count;
         (
-            &self.blocks[offset..end],
-            &self.ids[offset * LANES..end * LANES],
+            &self.blocks[first..end],
+            &self.ids[first * LANES..end * LANES],
         )
     }
 
     #[inline(always)]
-    fn closest<K: Kernel>(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let root = self.nodes.first()?;
+    fn closest<K: Kernel + WideBoxes>(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        if self.blocks.is_empty() {
+            return None;
+        }
         let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
         let mut bound = cull_bound(t_max);
-        root.enter(&o, &inv, bound)[0]?;
         let r = RayLanes::new(ray);
         let mut c = Closest::new(t_max);
-        let mut stack = [(0u32, 0f32); MAX_DEPTH];
+        // Nodes still to visit with their entry distances, farthest at the bottom of each
+        // node's run.
+        let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
         let mut sp = 0;
-        let mut i = 0usize;
+        let mut cur = self.root;
         loop {
-            let (pair, lane) = (&self.nodes[i >> 1], i & 1);
-            let (offset, count) = (pair.offset[lane] as usize, pair.count[lane] as usize);
-            if count > 0 {
-                let (blocks, ids) = self.leaf(offset, count);
+            if cur & LEAF != 0 {
+                let (blocks, ids) = self.leaf(cur);
                 blocks_closest::<K>(blocks, ids, ray, &r, &mut c);
                 if let Some(h) = c.best {
                     bound = cull_bound(h.t);
                 }
             } else {
-                let (a, b) = (offset, offset + 1);
-                let [ta, tb] = self.nodes[a >> 1].enter(&o, &inv, bound);
-                match (ta, tb) {
-                    (Some(ta), Some(tb)) => {
-                        // Nearer child first; the other waits with its entry distance.
-                        let (near, far, t_far) = if tb < ta { (b, a, ta) } else { (a, b, tb) };
-                        stack[sp] = (far as u32, t_far);
+                let node = &self.nodes[cur as usize];
+                let (mask, t) = K::enter(&node.boxes, &o, &inv, bound);
+                let mut mask = mask & node.valid;
+                if mask != 0 {
+                    let l = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    if mask == 0 {
+                        cur = node.child[l];
+                        continue;
+                    }
+                    // Two or more: push them sorted by entry distance, nearest on top, and
+                    // take the nearest.
+                    let base = sp;
+                    stack[sp] = MaybeUninit::new((node.child[l], t[l]));
+                    sp += 1;
+                    while mask != 0 {
+                        let l = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        let entry = (node.child[l], t[l]);
+                        let mut i = sp;
+                        // SAFETY: entries `base..sp` were written above.
+                        while i > base && unsafe { stack[i - 1].assume_init() }.1 < entry.1 {
+                            stack[i] = stack[i - 1];
+                            i -= 1;
+                        }
+                        stack[i] = MaybeUninit::new(entry);
                         sp += 1;
-                        i = near;
-                        continue;
                     }
-                    (Some(_), None) => {
-                        i = a;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        i = b;
-                        continue;
-                    }
-                    (None, None) => {}
+                    sp -= 1;
+                    // SAFETY: written above.
+                    cur = unsafe { stack[sp].assume_init() }.0;
+                    continue;
                 }
             }
             // Pop the next node the ray can still reach before the best hit.
@@ -238,9 +250,10 @@ impl Bvh {
                     return c.best;
                 }
                 sp -= 1;
-                let (n, t_enter) = stack[sp];
+                // SAFETY: every entry below `sp` has been written.
+                let (n, t_enter) = unsafe { stack[sp].assume_init() };
                 if t_enter <= bound {
-                    i = n as usize;
+                    cur = n;
                     break;
                 }
             }
@@ -248,40 +261,33 @@ impl Bvh {
     }
 
     #[inline(always)]
-    fn any<K: Kernel>(&self, ray: &Ray, t_max: f32) -> bool {
-        let Some(root) = self.nodes.first() else {
+    fn any<K: Kernel + WideBoxes>(&self, ray: &Ray, t_max: f32) -> bool {
+        if self.blocks.is_empty() {
             return false;
-        };
+        }
         let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
         let r = RayLanes::new(ray);
         let bound = cull_bound(t_max);
-        if root.enter(&o, &inv, bound)[0].is_none() {
-            return false;
-        }
-        let mut stack = [0u32; MAX_DEPTH];
+        let mut stack = [MaybeUninit::<u32>::uninit(); STACK];
         let mut sp = 0;
-        let mut i = 0usize;
+        let mut cur = self.root;
         loop {
-            let (pair, lane) = (&self.nodes[i >> 1], i & 1);
-            let (offset, count) = (pair.offset[lane] as usize, pair.count[lane] as usize);
-            if count > 0 {
-                if blocks_occluded::<K>(self.leaf(offset, count).0, ray, &r, t_max) {
+            if cur & LEAF != 0 {
+                if blocks_occluded::<K>(self.leaf(cur).0, ray, &r, t_max) {
                     return true;
                 }
             } else {
-                let (a, b) = (offset, offset + 1);
-                let [ta, tb] = self.nodes[a >> 1].enter(&o, &inv, bound);
-                let (ha, hb) = (ta.is_some(), tb.is_some());
-                if ha {
-                    if hb {
-                        stack[sp] = b as u32;
+                let node = &self.nodes[cur as usize];
+                let (mask, _) = K::enter(&node.boxes, &o, &inv, bound);
+                let mut mask = mask & node.valid;
+                if mask != 0 {
+                    cur = node.child[mask.trailing_zeros() as usize];
+                    mask &= mask - 1;
+                    while mask != 0 {
+                        stack[sp] = MaybeUninit::new(node.child[mask.trailing_zeros() as usize]);
                         sp += 1;
+                        mask &= mask - 1;
                     }
-                    i = a;
-                    continue;
-                }
-                if hb {
-                    i = b;
                     continue;
                 }
             }
@@ -289,7 +295,8 @@ impl Bvh {
                 return false;
             }
             sp -= 1;
-            i = stack[sp] as usize;
+            // SAFETY: every entry below `sp` has been written.
+            cur = unsafe { stack[sp].assume_init() };
         }
     }
 }

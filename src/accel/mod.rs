@@ -16,6 +16,7 @@
 //! ([`Isa::detect`]); every path gives the same hits, bit for bit.
 
 pub mod box4;
+pub mod box8;
 pub mod bvh;
 mod flat;
 mod hit;
@@ -178,7 +179,7 @@ impl Accel {
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         match &self.structure {
             Structure::Flat(flat) => flat.intersect(self.isa, ray, t_max),
-            Structure::Bvh(bvh) => bvh.intersect(ray, t_max),
+            Structure::Bvh(bvh) => bvh.intersect_isa(self.isa, ray, t_max),
         }
     }
 
@@ -187,7 +188,7 @@ impl Accel {
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         match &self.structure {
             Structure::Flat(flat) => flat.occluded(self.isa, ray, t_max),
-            Structure::Bvh(bvh) => bvh.occluded(ray, t_max),
+            Structure::Bvh(bvh) => bvh.occluded_isa(self.isa, ray, t_max),
         }
     }
 }
