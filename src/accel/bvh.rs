@@ -205,6 +205,8 @@ impl Bvh {
         loop {
             if cur & LEAF != 0 {
                 let (blocks, ids) = self.leaf(cur);
+                // The scene indices are read only for a hit, after the kernel: ask for them now.
+                prefetch(ids.as_ptr());
                 blocks_closest::<K>(blocks, ids, ray, &r, &mut c);
                 if let Some(h) = c.best {
                     bound = cull_bound(h.t);
@@ -299,6 +301,20 @@ impl Bvh {
             cur = unsafe { stack[sp].assume_init() };
         }
     }
+}
+
+/// Asks for the cache line at `p` (a hint: it reads nothing, cannot fault and changes no
+/// result).
+#[inline(always)]
+fn prefetch<T>(p: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch only hints the cache; it is defined for any address.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>(p.cast::<i8>());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
 }
 
 #[cfg(target_arch = "x86_64")]
