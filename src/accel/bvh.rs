@@ -197,9 +197,10 @@ impl Bvh {
         let mut bound = cull_bound(t_max);
         let r = RayLanes::new(ray);
         let mut c = Closest::new(t_max);
-        // Nodes still to visit with their entry distances, farthest at the bottom of each
-        // node's run.
-        let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
+        // Nodes still to visit as `entry distance's bits << 32 | reference`, each node's run
+        // sorted farthest at the bottom. An entry distance is `+0.0` or positive (the slab test
+        // starts at 0 and only raises it), so its bits order as the distances do.
+        let mut stack = [MaybeUninit::<u64>::uninit(); STACK];
         let mut sp = 0;
         let mut cur = self.root;
         loop {
@@ -224,16 +225,16 @@ impl Bvh {
                     }
                     // Two or more: push them sorted by entry distance, nearest on top, and
                     // take the nearest.
+                    let key = |l: usize| u64::from(t[l].to_bits()) << 32 | u64::from(node.child[l]);
                     let base = sp;
-                    stack[sp] = MaybeUninit::new((node.child[l], t[l]));
+                    stack[sp] = MaybeUninit::new(key(l));
                     sp += 1;
                     while mask != 0 {
-                        let l = mask.trailing_zeros() as usize;
+                        let entry = key(mask.trailing_zeros() as usize);
                         mask &= mask - 1;
-                        let entry = (node.child[l], t[l]);
                         let mut i = sp;
                         // SAFETY: entries `base..sp` were written above.
-                        while i > base && unsafe { stack[i - 1].assume_init() }.1 < entry.1 {
+                        while i > base && unsafe { stack[i - 1].assume_init() } < entry {
                             stack[i] = stack[i - 1];
                             i -= 1;
                         }
@@ -242,7 +243,7 @@ impl Bvh {
                     }
                     sp -= 1;
                     // SAFETY: written above.
-                    cur = unsafe { stack[sp].assume_init() }.0;
+                    cur = unsafe { stack[sp].assume_init() } as u32;
                     continue;
                 }
             }
@@ -253,9 +254,9 @@ impl Bvh {
                 }
                 sp -= 1;
                 // SAFETY: every entry below `sp` has been written.
-                let (n, t_enter) = unsafe { stack[sp].assume_init() };
-                if t_enter <= bound {
-                    cur = n;
+                let e = unsafe { stack[sp].assume_init() };
+                if f32::from_bits((e >> 32) as u32) <= bound {
+                    cur = e as u32;
                     break;
                 }
             }
