@@ -23,6 +23,7 @@ pub mod geometry;
 pub mod image;
 pub mod render;
 pub mod rng;
+pub mod sampler;
 pub mod scene;
 pub mod shading;
 

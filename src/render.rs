@@ -13,7 +13,7 @@ use crate::accel::Hit;
 use crate::camera::Camera;
 use crate::denoise::{GuidePixel, Guides, denoise};
 use crate::image::Image;
-use crate::rng::Rng;
+use crate::sampler::{SampleSource, Sampler, Stream};
 use crate::scene::{PointLight, Scene};
 use crate::shading::{RayCounts, Settings, Tracer};
 
@@ -127,7 +127,7 @@ fn sample(
     tracer: &Tracer,
     ray: &crate::geometry::Ray,
     hit: Option<Hit>,
-    rng: &mut Rng,
+    rng: &mut Stream,
     n: &mut RayCounts,
     guide: Option<&mut GuidePixel>,
 ) -> Vec3 {
@@ -155,6 +155,12 @@ fn render_impl(
     let start = Instant::now();
     let samples = settings.effects.samples.max(1);
     let tracer = Tracer::new(scene, lights, *settings);
+    // The sampler drives path-traced frames; the others keep their independent numbers.
+    let sampler = if tracer.splits() {
+        settings.effects.sampler
+    } else {
+        Sampler::Independent
+    };
     let rays = camera.rays(width, height);
     let (w, h) = (width as usize, height as usize);
     let mut image = Image::new(width, height);
@@ -202,7 +208,8 @@ fn render_impl(
                         n.primary += 1;
                         *hit = scene.intersect(&ray, f32::INFINITY);
                     }
-                    let mut rng = Rng::for_sample((y * w + x) as u64, 0, settings.frame);
+                    let mut rng =
+                        Stream::for_sample(sampler, (y * w + x) as u64, 0, 1, settings.frame);
                     let g = guide_row.as_mut().map(|r| &mut r[x]);
                     *px = sample(&tracer, &ray, *hit, &mut rng, &mut n, g);
                 }
@@ -224,10 +231,16 @@ fn render_impl(
                 for (x, px) in row.iter_mut().enumerate() {
                     let mut acc = Vec3::ZERO;
                     for s in 0..samples {
-                        let mut rng = Rng::for_sample((y * w + x) as u64, s, settings.frame);
-                        let (jx, jy) = (rng.next_f32(), rng.next_f32());
-                        // Stratified: an s×s grid when samples is square, else strata in x.
-                        let (ox, oy) = if square {
+                        let pixel = (y * w + x) as u64;
+                        let mut rng =
+                            Stream::for_sample(sampler, pixel, s, samples, settings.frame);
+                        // Stratified: the sampler's own offset (Sobol points are), else an
+                        // s×s grid when samples is square, else strata in x.
+                        let offset = rng.pixel_offset();
+                        let [jx, jy] = offset.unwrap_or_else(|| rng.next_2d());
+                        let (ox, oy) = if offset.is_some() {
+                            (jx, jy)
+                        } else if square {
                             (
                                 ((s % strata) as f32 + jx) / strata as f32,
                                 ((s / strata) as f32 + jy) / strata as f32,

@@ -37,8 +37,8 @@ fn text(b: &[u8]) -> String {
 }
 
 /// Rows per size: 5 seed stages, AA at 4 and 16 spp, GI at 4 bounce counts × the quick ladder
-/// (1 and 4 spp), then stage 6 raw and denoised at 1 and 4 spp.
-const ROWS_PER_SIZE: usize = 5 + 2 + 4 * 2 + 2 * 2;
+/// (1 and 4 spp), then stage 6 raw, raw with independent numbers, and denoised at 1 and 4 spp.
+const ROWS_PER_SIZE: usize = 5 + 2 + 4 * 2 + 3 * 2;
 const SIZES: usize = 2;
 
 /// The throughput section's table: header, alignment, and one row per ray kind (the quick
@@ -77,6 +77,19 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
         2 * SIZES
     );
     assert_eq!(stdout.matches("\n- GI + denoiser at ").count(), SIZES);
+    assert_eq!(
+        table
+            .iter()
+            .filter(|l| l.contains("| GI, independent numbers |"))
+            .count(),
+        2 * SIZES
+    );
+    assert_eq!(
+        stdout
+            .matches("the scene's sampler against independent numbers: 1 spp RMSE ")
+            .count(),
+        SIZES
+    );
     let header: Vec<&str> = table[0]
         .trim_matches('|')
         .split('|')
@@ -191,6 +204,7 @@ fn the_plot_draws_each_size_in_braille_with_every_series_marked() {
     for mark in [
         "1 GI, 1 bounce",
         "D GI + denoiser",
+        "I GI, independent numbers",
         "R GI, roulette",
         "+ goal",
     ] {
@@ -279,9 +293,11 @@ fn the_svg_is_well_formed_with_one_polyline_per_bounce_count() {
     assert!(svg.starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\""));
     let names = elements(&svg);
     assert_eq!(names[0], "svg");
-    // Raw GI at 1, 2, 4, 8 and stage 6's roulette cap (16) bounces, and GI + denoiser.
-    assert_eq!(names.iter().filter(|n| *n == "polyline").count(), 6 * SIZES);
+    // Raw GI at 1, 2, 4, 8 and stage 6's roulette cap (16) bounces, stage 6 with independent
+    // numbers, and GI + denoiser.
+    assert_eq!(names.iter().filter(|n| *n == "polyline").count(), 7 * SIZES);
     assert_eq!(svg.matches("polyline class=\"denoised\"").count(), SIZES);
+    assert_eq!(svg.matches("polyline class=\"independent\"").count(), SIZES);
     for b in [1, 2, 4, 8, 16] {
         let tag = format!("class=\"gi\" data-bounces=\"{b}\" points=\"");
         let lines: Vec<&str> = svg.lines().filter(|l| l.contains(&tag)).collect();

@@ -103,6 +103,10 @@ fn bad_values_get_a_clear_message_and_status_2() {
         (&["render", "--light", "0,nan,0"], "out of range"),
         (&["render", "--light", "0,x,0"], "is not a number"),
         (
+            &["render", "--sampler", "halton"],
+            "'halton' is not a sampler: expected independent or sobol",
+        ),
+        (
             &[
                 "render",
                 "--pixels",

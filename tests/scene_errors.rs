@@ -250,6 +250,14 @@ fn samples_and_bounces_out_of_range() {
         12,
         &["\"none\"", "bounces = n"],
     );
+    let err = fails(&d, "[effects]\nsampler = \"halton\"\n");
+    says(
+        &err,
+        &d.join("scene.toml"),
+        2,
+        11,
+        &["unknown sampler `halton`", "independent or sobol"],
+    );
 }
 
 #[test]

@@ -26,6 +26,7 @@ use crate::frame::{CellGrid, ColorMode, encode_text};
 use crate::image::Image;
 use crate::render::render;
 use crate::render::render_denoised;
+use crate::sampler::Sampler;
 use crate::scene::{Effects, Indirect, Scene};
 use crate::shading::{GI_MAX_BOUNCES, Mode, RayCounts, Settings, Stage};
 
@@ -135,6 +136,12 @@ pub enum RowKind {
         /// Samples per pixel.
         spp: u32,
     },
+    /// Stage 6 raw with independent random numbers instead of the scene's sampler (Sobol by
+    /// default): what the sampler buys at equal samples.
+    Independent {
+        /// Samples per pixel.
+        spp: u32,
+    },
     /// Stage 6 (path-traced, at most [`GI_MAX_BOUNCES`] bounces) with the denoiser; the time
     /// includes the filter.
     Denoised {
@@ -151,6 +158,7 @@ impl RowKind {
             RowKind::Stage(s) => s.name().into(),
             RowKind::Aa { .. } => "AA (seed, N = 0.5)".into(),
             RowKind::Gi { .. } => "GI".into(),
+            RowKind::Independent { .. } => "GI, independent numbers".into(),
             RowKind::Denoised { .. } => "GI + denoiser".into(),
         }
     }
@@ -159,7 +167,10 @@ impl RowKind {
     pub fn spp(&self) -> u32 {
         match *self {
             RowKind::Stage(_) => 1,
-            RowKind::Aa { spp } | RowKind::Gi { spp, .. } | RowKind::Denoised { spp } => spp,
+            RowKind::Aa { spp }
+            | RowKind::Gi { spp, .. }
+            | RowKind::Independent { spp }
+            | RowKind::Denoised { spp } => spp,
         }
     }
 
@@ -167,12 +178,13 @@ impl RowKind {
     pub fn bounces(&self) -> Option<u32> {
         match *self {
             RowKind::Gi { bounces, .. } => Some(bounces),
-            RowKind::Denoised { .. } => Some(GI_MAX_BOUNCES),
+            RowKind::Independent { .. } | RowKind::Denoised { .. } => Some(GI_MAX_BOUNCES),
             _ => None,
         }
     }
 
-    /// Maximum bounces of a raw GI row (`None` for every other row, denoised ones included).
+    /// Maximum bounces of a raw GI row with the scene's sampler (`None` for every other row,
+    /// denoised and independent ones included).
     pub fn raw_bounces(&self) -> Option<u32> {
         match *self {
             RowKind::Gi { bounces, .. } => Some(bounces),
@@ -195,9 +207,19 @@ impl RowKind {
                     shadows: true,
                     indirect: Indirect::PathTraced { bounces },
                     samples: spp,
+                    sampler: scene.effects().sampler,
                 },
                 frame: 0,
             },
+            RowKind::Independent { spp } => {
+                let mut s = RowKind::Gi {
+                    bounces: GI_MAX_BOUNCES,
+                    spp,
+                }
+                .settings(scene);
+                s.effects.sampler = Sampler::Independent;
+                s
+            }
             RowKind::Denoised { spp } => RowKind::Gi {
                 bounces: GI_MAX_BOUNCES,
                 spp,
@@ -266,7 +288,7 @@ pub struct BenchReport {
 }
 
 /// The rows of one size: the seed's stages, anti-aliasing, GI by bounces and samples, then
-/// stage 6 raw and denoised.
+/// stage 6 raw, raw with independent numbers (the sampler's effect), and denoised.
 pub fn rows_for(options: &BenchOptions) -> Vec<RowKind> {
     let mut rows: Vec<RowKind> = SEED_STAGES.iter().map(|&s| RowKind::Stage(s)).collect();
     rows.extend(AA_SPP.iter().map(|&spp| RowKind::Aa { spp }));
@@ -282,6 +304,7 @@ pub fn rows_for(options: &BenchOptions) -> Vec<RowKind> {
         bounces: GI_MAX_BOUNCES,
         spp,
     }));
+    rows.extend(stage6.clone().map(|&spp| RowKind::Independent { spp }));
     rows.extend(stage6.map(|&spp| RowKind::Denoised { spp }));
     rows
 }
@@ -418,7 +441,7 @@ mod tests {
     fn rows_cover_the_stages_aa_and_every_bounce_count() {
         let o = BenchOptions::quick();
         let rows = rows_for(&o);
-        assert_eq!(rows.len(), 5 + 2 + 4 * o.spp_ladder().len() + 2 * 2);
+        assert_eq!(rows.len(), 5 + 2 + 4 * o.spp_ladder().len() + 3 * 2);
         assert_eq!(rows[4], RowKind::Stage(Stage::Indirect));
         assert_eq!(rows[6], RowKind::Aa { spp: 16 });
         assert_eq!(rows[6 + 4 * 2], RowKind::Gi { bounces: 8, spp: 4 });
@@ -429,6 +452,7 @@ mod tests {
                 spp: 1
             }
         );
+        assert_eq!(rows[rows.len() - 3], RowKind::Independent { spp: 4 });
         assert_eq!(rows.last(), Some(&RowKind::Denoised { spp: 4 }));
     }
 }

@@ -90,6 +90,37 @@ pub fn markdown(report: &BenchReport, command: &str) -> String {
             each.join(", ")
         );
     }
+    for (w, h) in sizes(report) {
+        let pairs: Vec<String> = report
+            .rows
+            .iter()
+            .filter(|r| (r.width, r.height) == (w, h))
+            .filter_map(|i| {
+                let RowKind::Independent { spp } = i.kind else {
+                    return None;
+                };
+                let own = report.rows.iter().find(|r| {
+                    (r.width, r.height) == (w, h)
+                        && r.kind
+                            == RowKind::Gi {
+                                bounces: crate::shading::GI_MAX_BOUNCES,
+                                spp,
+                            }
+                })?;
+                Some(format!(
+                    "{spp} spp RMSE {:.4} in {:.1} ms against {:.4} in {:.1} ms",
+                    own.rmse, own.median_ms, i.rmse, i.median_ms
+                ))
+            })
+            .collect();
+        if !pairs.is_empty() {
+            let _ = writeln!(
+                s,
+                "- stage 6 raw at {w}x{h}, the scene's sampler against independent numbers: {}",
+                pairs.join(", ")
+            );
+        }
+    }
     for seed in report
         .rows
         .iter()

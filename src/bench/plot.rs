@@ -84,10 +84,11 @@ impl Canvas {
 }
 
 /// The letter that marks a series' points: its bounce count's first digit for raw GI (`R` for
-/// stage 6's roulette), `D` for GI + denoiser.
+/// stage 6's roulette, `I` for it with independent numbers), `D` for GI + denoiser.
 fn letter(r: &Row) -> char {
     match r.kind {
         RowKind::Denoised { .. } => 'D',
+        RowKind::Independent { .. } => 'I',
         RowKind::Gi { bounces, .. } if bounces == crate::shading::GI_MAX_BOUNCES => 'R',
         RowKind::Gi { bounces, .. } => char::from_digit(bounces % 10, 10).unwrap_or('G'),
         RowKind::Aa { .. } => 'a',

@@ -12,6 +12,7 @@ use super::progress::Progress;
 
 use crate::image::Image;
 use crate::render::render;
+use crate::sampler::Sampler;
 use crate::scene::{Effects, Indirect, Scene};
 use crate::shading::{Mode, Settings};
 
@@ -81,6 +82,9 @@ impl ReferenceSpec {
                     bounces: self.bounces,
                 },
                 samples: PASS_SPP,
+                // The cached references were rendered with independent numbers: keep them,
+                // bit for bit.
+                sampler: Sampler::Independent,
             },
             frame: FRAME_BASE + pass,
         }
@@ -366,6 +370,18 @@ mod tests {
         assert!(info.cached && info.describe().contains("read from the cache"));
         assert_eq!(again, resumed);
         let _ = fs::remove_dir_all(&tmp);
+    }
+
+    /// References take independent numbers, whatever the scene's sampler: their cached files
+    /// were rendered so (`tests/determinism.rs` pins that sampler's frames bit for bit).
+    #[test]
+    fn references_use_independent_numbers() {
+        let scene = crate::scene::cornell::cornell_box();
+        assert_eq!(scene.effects().sampler, Sampler::Sobol);
+        let spec = ReferenceSpec::new(&scene, 12, 10, 32, 4);
+        for pass in 0..2 {
+            assert_eq!(spec.settings(pass).effects.sampler, Sampler::Independent);
+        }
     }
 
     /// A corrupt cache file (here a header whose size overflows, which used to be read with

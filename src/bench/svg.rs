@@ -167,7 +167,9 @@ fn panel(s: &mut String, x0: f64, w: u32, h: u32, rows: &[&Row]) {
             let label = match r.kind {
                 RowKind::Aa { spp } => format!("AA {spp} spp"),
                 RowKind::Stage(st) => st.name().to_string(),
-                RowKind::Gi { .. } | RowKind::Denoised { .. } => return None,
+                RowKind::Gi { .. } | RowKind::Independent { .. } | RowKind::Denoised { .. } => {
+                    return None;
+                }
             };
             Some((x(r.median_ms), y(r.rmse), label))
         })
@@ -209,7 +211,8 @@ fn panel(s: &mut String, x0: f64, w: u32, h: u32, rows: &[&Row]) {
 }
 
 /// The plotted series of one size's rows, in order: raw GI by bounce count (its points are
-/// the spp ladder), then GI + denoiser. Each is (legend, SVG class, rows).
+/// the spp ladder), stage 6 raw with independent numbers, then GI + denoiser. Each is
+/// (legend, SVG class, rows).
 pub fn series<'a>(rows: &[&'a Row]) -> Vec<(String, &'static str, Vec<&'a Row>)> {
     let mut out: Vec<(String, &'static str, Vec<&'a Row>)> = Vec::new();
     let mut bounces: Vec<u32> = rows.iter().filter_map(|r| r.kind.raw_bounces()).collect();
@@ -227,6 +230,14 @@ pub fn series<'a>(rows: &[&'a Row]) -> Vec<(String, &'static str, Vec<&'a Row>)>
             format!("GI, {b} bounce{}", if b == 1 { "" } else { "s" })
         };
         out.push((name, "gi", members));
+    }
+    let independent: Vec<&Row> = rows
+        .iter()
+        .filter(|r| matches!(r.kind, RowKind::Independent { .. }))
+        .copied()
+        .collect();
+    if !independent.is_empty() {
+        out.push(("GI, independent numbers".into(), "independent", independent));
     }
     let denoised: Vec<&Row> = rows
         .iter()

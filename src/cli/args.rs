@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
+use raytty::sampler::Sampler;
 use raytty::scene::MAX_COORDINATE;
 use raytty::{ColorMode, Stage};
 
@@ -155,6 +156,10 @@ pub(super) struct RenderArgs {
     /// in the gi stage (one sample is noisy). Default: the scene's (1 for gi).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub(super) samples: Option<u32>,
+    /// Where path-traced samples' numbers come from: sobol (Owen-scrambled Sobol points, less
+    /// noise at equal samples) or independent (random numbers). Default: the scene's (sobol).
+    #[arg(long, value_parser = parse_sampler)]
+    pub(super) sampler: Option<Sampler>,
     /// Denoise the gi stage's indirect light (on, the default) or give the raw, unbiased
     /// path-traced estimate (off). Other stages have no noise to remove.
     #[arg(long, value_enum, default_value_t = Switch::On)]
@@ -197,6 +202,13 @@ pub(super) fn parse_size(s: &str) -> Result<(u32, u32), String> {
         return Err(bad());
     }
     Ok((w, h))
+}
+
+pub(super) fn parse_sampler(s: &str) -> Result<Sampler, String> {
+    Sampler::from_name(s).ok_or_else(|| {
+        let names: Vec<_> = Sampler::ALL.iter().map(|s| s.name()).collect();
+        format!("'{s}' is not a sampler: expected {}", names.join(" or "))
+    })
 }
 
 pub(super) fn parse_stage(s: &str) -> Result<Stage, String> {

@@ -221,6 +221,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
             color: None,
             stage: Stage::Indirect,
             samples: None,
+            sampler: None,
             denoise: Switch::On,
             camera: None,
             light: None,

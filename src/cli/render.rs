@@ -97,6 +97,9 @@ pub(super) fn run_render(
     if let Some(n) = args.samples {
         settings.effects.samples = n;
     }
+    if let Some(s) = args.sampler {
+        settings.effects.sampler = s;
+    }
     if args.output.is_none() && stdout_was_closed() {
         return Err(anyhow::anyhow!(
             "stdout is closed: there is nowhere to write the frame (redirect it, or give -o FILE)"

@@ -17,6 +17,7 @@ use rayon::prelude::*;
 use crate::accel::{Accel, AccelKind, AccelStats, Hit, Isa};
 use crate::camera::Camera;
 use crate::geometry::{Aabb, DegenerateTriangle, Ray, Triangle};
+use crate::sampler::Sampler;
 
 /// Largest absolute coordinate accepted anywhere a user gives one (scene files, OBJ vertices,
 /// `--camera` and `--light`; box corners and transformed vertices too): far beyond any sensible
@@ -75,6 +76,8 @@ pub struct Effects {
     pub indirect: Indirect,
     /// Samples per pixel (stratified within the pixel; 1 = one ray through the centre).
     pub samples: u32,
+    /// Where the samples' numbers come from.
+    pub sampler: Sampler,
 }
 
 impl Effects {
@@ -83,6 +86,7 @@ impl Effects {
         shadows: true,
         indirect: Indirect::Constant(0.5),
         samples: 1,
+        sampler: Sampler::Sobol,
     };
 }
 

@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use crate::accel::Hit;
 use crate::geometry::{Ray, hit_point, offset_ray_origin};
-use crate::rng::Rng;
+use crate::sampler::SampleSource;
 use crate::scene::{Indirect, Material, PointLight, Scene};
 
 mod split;
@@ -66,7 +66,7 @@ impl<'a> Tracer<'a> {
         &self,
         ray: &Ray,
         hit: Option<Hit>,
-        rng: &mut Rng,
+        rng: &mut impl SampleSource,
         n: &mut RayCounts,
     ) -> Vec3 {
         let Some(hit) = hit else { return Vec3::ZERO };
@@ -89,7 +89,7 @@ impl<'a> Tracer<'a> {
         &self,
         ray: &Ray,
         hit: Option<Hit>,
-        rng: &mut Rng,
+        rng: &mut impl SampleSource,
         n: &mut RayCounts,
     ) -> SplitSample {
         let Some(hit) = hit else {
@@ -105,7 +105,7 @@ impl<'a> Tracer<'a> {
         ray: &Ray,
         hit: &Hit,
         mirror_depth: u32,
-        rng: &mut Rng,
+        rng: &mut impl SampleSource,
         n: &mut RayCounts,
     ) -> SplitSample {
         let tri = &self.scene.triangles()[hit.triangle as usize];
@@ -182,7 +182,7 @@ impl<'a> Tracer<'a> {
         ray: &Ray,
         mirror_depth: u32,
         bounce: u32,
-        rng: &mut Rng,
+        rng: &mut impl SampleSource,
         n: &mut RayCounts,
     ) -> Vec3 {
         match self.scene.intersect(ray, f32::INFINITY) {
@@ -197,7 +197,7 @@ impl<'a> Tracer<'a> {
         hit: &Hit,
         mirror_depth: u32,
         bounce: u32,
-        rng: &mut Rng,
+        rng: &mut impl SampleSource,
         n: &mut RayCounts,
     ) -> Vec3 {
         let tri = &self.scene.triangles()[hit.triangle as usize];
@@ -248,7 +248,7 @@ impl<'a> Tracer<'a> {
         normal: Vec3,
         mirror_depth: u32,
         bounce: u32,
-        rng: &mut Rng,
+        rng: &mut impl SampleSource,
         n: &mut RayCounts,
     ) -> Vec3 {
         match self.settings.effects.indirect {
@@ -263,7 +263,7 @@ impl<'a> Tracer<'a> {
                 } else {
                     1.0
                 };
-                if q < 1.0 && rng.next_f32() >= q {
+                if q < 1.0 && rng.next_1d() >= q {
                     Vec3::ZERO
                 } else {
                     let dir = cosine_sample(normal, rng);
@@ -315,8 +315,8 @@ impl<'a> Tracer<'a> {
 }
 
 /// A cosine-weighted direction on the hemisphere around `n` (unit length).
-pub(crate) fn cosine_sample(n: Vec3, rng: &mut Rng) -> Vec3 {
-    let (u1, u2) = (rng.next_f32(), rng.next_f32());
+pub(crate) fn cosine_sample(n: Vec3, rng: &mut impl SampleSource) -> Vec3 {
+    let [u1, u2] = rng.next_2d();
     let r = u1.sqrt();
     let phi = 2.0 * PI * u2;
     let (s, c) = (libm::sinf(phi), libm::cosf(phi));

@@ -55,6 +55,7 @@ impl Stage {
             shadows: false,
             indirect: Indirect::None,
             samples: 1,
+            sampler: scene.sampler,
         };
         let (mode, effects) = match self {
             Stage::Flat => (Mode::Flat, none),
@@ -76,6 +77,7 @@ impl Stage {
                         bounces: GI_MAX_BOUNCES,
                     },
                     samples: 1,
+                    sampler: scene.sampler,
                 },
             ),
         };

@@ -15,6 +15,7 @@ use super::spec::{
 };
 use super::*;
 use crate::camera::Camera;
+use crate::sampler::Sampler;
 use crate::scene::{Effects, Indirect, Material, PointLight, SceneBuilder};
 use toml::Spanned;
 
@@ -199,6 +200,16 @@ fn effects(cx: &Ctx, spec: Option<&EffectsSpec>) -> Result<Effects, SceneFileErr
     }
     if let Some(s) = &e.samples {
         effects.samples = cx.whole(s, 1, MAX_SAMPLES, "samples (per pixel)")? as u32;
+    }
+    if let Some(s) = &e.sampler {
+        let name = s.get_ref().as_str();
+        effects.sampler = Sampler::from_name(name).ok_or_else(|| {
+            let names: Vec<&str> = Sampler::ALL.iter().map(|s| s.name()).collect();
+            cx.err_at(
+                s,
+                format!("unknown sampler `{name}`: expected {}", names.join(" or ")),
+            )
+        })?;
     }
     Ok(effects)
 }

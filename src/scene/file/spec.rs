@@ -78,6 +78,7 @@ pub struct EffectsSpec {
     pub shadows: Option<bool>,
     pub indirect: Option<Spanned<IndirectSpec>>,
     pub samples: Option<Spanned<i64>>,
+    pub sampler: Option<Spanned<String>>,
 }
 
 /// Exactly three values: `[a, b, c]` (serde's arrays would take a fourth in silence).
