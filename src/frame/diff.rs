@@ -6,9 +6,9 @@
 //!   as foreground) or `▄` (lower pixel as foreground), and a cell of one colour as a space
 //!   (background) or `█` (foreground);
 //! - one SGR sets the foreground and the background together, and only what changes;
-//! - an exact diff sends its block cells in the order that reuses the pen's colours most,
-//!   across the whole screen (`exact.rs`); within a tolerance, row by row, each row's next
-//!   cell the cheapest of the next few.
+//! - block cells are sent in the order that reuses the pen's colours most, across the whole
+//!   screen (`exact.rs`); within a tolerance, with colours rounded to a lattice of that
+//!   spacing, so that neighbours share them exactly.
 
 use super::{Cell, CellGrid, Colour, Pen, UPPER_HALF, WIDE_TAIL, half_block, write_char};
 
@@ -17,8 +17,8 @@ pub const LOWER_HALF: char = '▄';
 /// The full block: its foreground paints both pixels.
 pub const FULL_BLOCK: char = '█';
 
-/// Within a row of a diff within a tolerance (and for text), the next cell sent is the cheapest (cursor move, SGR, character) of the next
-/// this many cells to send: a few bytes of cursor move buy a cell whose colours the pen holds.
+/// Text cells (the status line, the help) are sent row by row, the next the cheapest (cursor
+/// move, SGR, character) of the next this many to send.
 const ORDER_WINDOW: usize = 16;
 
 /// How far a cell on screen may be from the frame's: a cell is sent if any channel of either
@@ -103,7 +103,8 @@ pub fn encode_diff(prev: Option<&CellGrid>, next: &CellGrid, top: usize, out: &m
 
 /// Like [`encode_diff`], within `limits`, updating `shown` (what the screen shows; `None` or
 /// another size: unknown, so every cell is sent) to what it shows afterwards. Cells within the
-/// tolerance are left as they are; a cell that is sent is sent exactly.
+/// tolerance are left as they are; a block cell that is sent is sent within it (each channel
+/// rounded to a multiple of 2·tolerance + 1, so that nearby cells share colours).
 pub fn encode_diff_within(
     shown: &mut Option<CellGrid>,
     next: &CellGrid,
@@ -144,16 +145,7 @@ pub fn encode_diff_within(
         max_error: 0,
     };
     let cols = next.cols;
-    if limits.tolerance == 0 {
-        exact::send_block_cells(
-            screen,
-            next,
-            limits.first_row,
-            &mut w,
-            out,
-            (start, limits.max_bytes),
-        );
-    }
+    exact::send_block_cells(screen, next, limits, &mut w, out, start);
     'rows: for k in 0..next.rows {
         let r = (limits.first_row + k) % next.rows.max(1);
         let row = r * cols..(r + 1) * cols;
@@ -167,9 +159,8 @@ pub fn encode_diff_within(
             distance(&have[c], &want[c]) > limits.tolerance as u16
                 || (tail && have[c + 1] != want[c + 1])
         };
-        // What is sent for a cell: within a tolerance, a pixel takes a colour the pen holds
-        // if that is close enough, so that neighbours share colours and the pen carries over.
-        let send = |pen: Pen, c: usize| snap(&want[c], pen, limits.tolerance);
+        // Block cells were sent above (or the budget stopped them): what is left is text.
+        let send = |_: Pen, c: usize| want[c];
         let mut todo: Vec<usize> = (0..cols).filter(|&c| dirty(have, c)).collect();
         while !todo.is_empty() {
             // Over the budget, only text is still sent (the status line, the help): image
@@ -220,28 +211,19 @@ pub fn encode_diff_within(
     outcome
 }
 
-/// `cell` with each pixel of a truecolor block cell replaced by the pen's foreground or
-/// background colour when that is within `tolerance` of it (0: `cell` as it is). A colour the
-/// pen holds costs no SGR, so an approximate frame costs a fraction of an exact one, and the
-/// pixels that are sent as they are need no second visit.
-fn snap(cell: &Cell, pen: Pen, tolerance: u8) -> Cell {
-    let near = |a: Colour, b: Option<Colour>| match (a, b) {
-        (Colour::Rgb(r0, g0, b0), Some(Colour::Rgb(r1, g1, b1))) => {
-            r0.abs_diff(r1).max(g0.abs_diff(g1)).max(b0.abs_diff(b1)) <= tolerance
-        }
-        _ => false,
-    };
-    let pick = |c: Colour| {
-        if near(c, pen.fg) {
-            pen.fg.unwrap_or(c)
-        } else if near(c, pen.bg) {
-            pen.bg.unwrap_or(c)
-        } else {
-            c
-        }
+/// What is sent for `cell` within `tolerance`: each channel of a truecolor pixel rounded to the
+/// nearest multiple of `2·tolerance + 1` (at most `tolerance` off; 0: the cell as it is). Nearby
+/// pixels then share exact colours, so an approximate frame sends a colour for a whole patch
+/// of cells rather than for each (about 7 bytes a cell within 8 levels against 17 exact).
+fn quantize(cell: &Cell, tolerance: u8) -> Cell {
+    let step = 2 * u16::from(tolerance) + 1;
+    let level = |v: u8| ((u16::from(v) + step / 2) / step * step).min(255) as u8;
+    let round = |c: Colour| match c {
+        Colour::Rgb(r, g, b) => Colour::Rgb(level(r), level(g), level(b)),
+        c => c,
     };
     match pixels(cell) {
-        Some((up, lo)) if tolerance > 0 => half_block(pick(up), pick(lo)),
+        Some((up, lo)) if tolerance > 0 => half_block(round(up), round(lo)),
         _ => *cell,
     }
 }

@@ -67,6 +67,8 @@ pub struct Screen {
     cache: HitCache,
     /// The app generation the image shows, once rendered.
     generation: Option<u64>,
+    /// The generation the last draw showed.
+    drawn: Option<u64>,
     /// The GI passes so far, as the denoiser's guides (means over the passes).
     guides: Option<Guides>,
     passes: u32,
@@ -102,11 +104,14 @@ pub struct LinkView {
 
 /// Tolerances tried for a frame over its budget, smallest first (levels per channel).
 const TOLERANCES: [u8; 5] = [0, 8, 16, 32, 64];
-/// What a sent cell costs on average, in bytes (truecolor, measured by `frame_bytes`: 20-25),
-/// to guess from a count of cells which tolerance fits a budget.
-const CELL_BYTES: usize = 24;
-/// The same for a cell sent within a tolerance, whose coarse colours often repeat.
-const COARSE_CELL_BYTES: usize = 10;
+/// What a cell sent within each of [`TOLERANCES`] costs, in bytes, to guess from a count of
+/// cells which tolerance fits a budget: a light move 1 to 4 presses behind, at 120×40 and
+/// 200×50, cost 14-18 B a cell exact and 6-8, 5-6, 4-6, 3-5 within 8, 16, 32, 64 levels
+/// (coarser colours are shared by more cells).
+const CELL_BYTES: [usize; 5] = [18, 7, 6, 5, 4];
+/// Once the app stops changing, the first refinement goes straight to this tolerance (a
+/// ladder of coarser ones would send most cells again at each rung), then to exact.
+const REFINE_TOLERANCE: u8 = 8;
 
 /// The image size for a terminal of `cols × rows` cells, or `None` if it is too small.
 pub fn image_size(size: (u16, u16)) -> Option<(u32, u32)> {
@@ -120,6 +125,7 @@ impl Screen {
         Screen {
             cache: HitCache::new(),
             generation: None,
+            drawn: None,
             guides: None,
             passes: 0,
             gi_view: None,
@@ -267,10 +273,13 @@ impl Screen {
             }
             g
         };
+        // The same image as the last draw's (its status line aside): this draw refines it.
+        let refining = self.drawn == self.generation && self.passes >= GI_MAX_PASSES;
+        self.drawn = self.generation;
         let limits = match self.link.budget {
             None => DiffLimits::EXACT,
             Some(max_bytes) => DiffLimits {
-                tolerance: tolerance_for(self.shown.as_ref(), &grid, max_bytes),
+                tolerance: tolerance_for(self.shown.as_ref(), &grid, max_bytes, refining),
                 max_bytes,
                 first_row: self.next_row,
             },
@@ -359,8 +368,14 @@ impl Screen {
 
 /// The smallest of [`TOLERANCES`] whose cells to send (those of `next` further than it from
 /// `shown`) fit in `max_bytes` at [`CELL_BYTES`] each, else the largest (the budget then cuts
-/// the frame short). Exact when the screen is unknown (a first frame or a new size).
-fn tolerance_for(shown: Option<&CellGrid>, next: &CellGrid, max_bytes: usize) -> u8 {
+/// the frame short); when `refining` (`next` is the frame the last draw approximated), at most
+/// [`REFINE_TOLERANCE`]. Exact when the screen is unknown (a first frame or a new size).
+fn tolerance_for(
+    shown: Option<&CellGrid>,
+    next: &CellGrid,
+    max_bytes: usize,
+    refining: bool,
+) -> u8 {
     let Some(shown) = shown.filter(|s| s.cols == next.cols && s.rows == next.rows) else {
         return 0;
     };
@@ -375,17 +390,18 @@ fn tolerance_for(shown: Option<&CellGrid>, next: &CellGrid, max_bytes: usize) ->
             *n += usize::from(d > u16::from(t));
         }
     }
-    let fits = |i: usize| {
-        let per_cell = if i == 0 {
-            CELL_BYTES
-        } else {
-            COARSE_CELL_BYTES
-        };
-        beyond[i] * per_cell <= max_bytes
-    };
-    let i = (0..TOLERANCES.len())
+    let fits = |i: usize| beyond[i] * CELL_BYTES[i] <= max_bytes;
+    let mut i = (0..TOLERANCES.len())
         .find(|&i| fits(i))
         .unwrap_or(TOLERANCES.len() - 1);
+    if refining {
+        i = i.min(
+            TOLERANCES
+                .iter()
+                .position(|&t| t == REFINE_TOLERANCE)
+                .unwrap_or(i),
+        );
+    }
     // Always progress: a tolerance that sends nothing while the screen is not exact gives way
     // to the largest smaller one that sends something (the budget cuts it short).
     let i = (0..=i).rev().find(|&j| beyond[j] > 0).unwrap_or(i);

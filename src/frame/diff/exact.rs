@@ -10,7 +10,9 @@
 
 use std::collections::{BTreeSet, HashMap};
 
-use super::{Cell, CellGrid, Colour, Writer, pixels, sgr_cost, ways};
+use super::{
+    Cell, CellGrid, Colour, DiffLimits, Writer, distance, pixels, quantize, sgr_cost, ways,
+};
 
 /// Cells by position in reading order (from the diff's first row), so the nearest to the
 /// cursor is a range query.
@@ -64,17 +66,23 @@ impl Pending {
     }
 }
 
-/// Sends the block cells of `next` that `screen` does not show exactly, cheapest first (see the
-/// module's note), updating `screen`, until `out` holds `max_bytes` since `start`. Text cells are
-/// left to the caller (they are few, and their colours are not a pixel's).
+/// Sends the block cells of `next` that `screen` shows further than the tolerance from it
+/// (0: not exactly), [`quantize`]d to the tolerance, cheapest first (see the module's note),
+/// updating `screen`, until `out` holds `max_bytes` since `start`. Text cells are left to the
+/// caller (they are few, and their colours are not a pixel's).
 pub(super) fn send_block_cells(
     screen: &mut CellGrid,
     next: &CellGrid,
-    first_row: usize,
+    limits: DiffLimits,
     w: &mut Writer,
     out: &mut Vec<u8>,
-    (start, max_bytes): (usize, usize),
+    start: usize,
 ) {
+    let DiffLimits {
+        tolerance,
+        max_bytes,
+        first_row,
+    } = limits;
     let (cols, rows) = (next.cols, next.rows);
     if cols == 0 || rows == 0 {
         return;
@@ -82,12 +90,23 @@ pub(super) fn send_block_cells(
     // Position in reading order from `first_row`, and back.
     let place = |r: usize, c: usize| ((r + rows - first_row % rows) % rows) * cols + c;
     let cell_at = |p: usize| ((p / cols + first_row) % rows, p % cols);
+    // What is sent for each cell (only block cells further than the tolerance are).
+    let send: Vec<Cell> = (screen.cells.iter().zip(&next.cells))
+        .map(|(have, want)| {
+            let far = distance(have, want) > u16::from(tolerance);
+            if far && pixels(want).is_some() {
+                quantize(want, tolerance)
+            } else {
+                *have
+            }
+        })
+        .collect();
     let mut pending = Pending::default();
     for r in 0..rows {
         for c in 0..cols {
             let i = r * cols + c;
-            if let Some(px) = pixels(&next.cells[i])
-                && screen.cells[i] != next.cells[i]
+            if let Some(px) = pixels(&send[i])
+                && screen.cells[i] != send[i]
             {
                 pending.change(place(r, c), px, true);
             }
@@ -99,11 +118,11 @@ pub(super) fn send_block_cells(
         if let Some((r, c)) = w.cursor {
             here = place(r, c);
         }
-        let Some(p) = pick(w, next, &pending, here, &cell_at) else {
+        let Some(p) = pick(w, &send, cols, &pending, here, &cell_at) else {
             break;
         };
         let (r, c) = cell_at(p);
-        let cell = next.cells[r * cols + c];
+        let cell = send[r * cols + c];
         if let Some(px) = pixels(&cell) {
             pending.change(p, px, false);
         }
@@ -129,20 +148,21 @@ pub(super) fn send_block_cells(
 /// after the cursor.
 fn pick(
     w: &Writer,
-    next: &CellGrid,
+    send: &[Cell],
+    cols: usize,
     pending: &Pending,
     here: usize,
     cell_at: &impl Fn(usize) -> (usize, usize),
 ) -> Option<usize> {
     if pending.all.contains(&here) && w.cursor.is_some() {
         let (r, c) = cell_at(here);
-        if w.draw_cost(&next.cells[r * next.cols + c]) == 0 {
+        if w.draw_cost(&send[r * cols + c]) == 0 {
             return Some(here);
         }
     }
     let cost = |p: usize| {
         let (r, c) = cell_at(p);
-        w.move_len(r, c) + w.draw_cost(&next.cells[r * next.cols + c])
+        w.move_len(r, c) + w.draw_cost(&send[r * cols + c])
     };
     let cheapest = |places: Vec<usize>| places.into_iter().min_by_key(|&p| (cost(p), p));
     let (fg, bg) = (w.pen.fg.map(key), w.pen.bg.map(key));

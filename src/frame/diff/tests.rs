@@ -316,3 +316,37 @@ fn an_exact_diff_sends_each_pair_of_colours_once_wherever_its_cells_are() {
         String::from_utf8_lossy(&out)
     );
 }
+
+#[test]
+fn within_a_tolerance_a_gradient_shares_a_few_colours_each_within_it() {
+    // A smooth gradient, one level a cell: exact, every cell needs its own colour; within 8
+    // levels, colours rounded to multiples of 17 cover whole stretches of it.
+    let grey = |v: u8| Colour::Rgb(v, v, v);
+    let next = grid(
+        (0..40)
+            .map(|i| block(grey(100 + i), grey(100 + i)))
+            .collect(),
+        40,
+    );
+    let prev = grid(vec![block(grey(0), grey(0)); 40], 40);
+    let sgrs = |tolerance: u8| {
+        let mut shown = Some(prev.clone());
+        let mut out = Vec::new();
+        let limits = DiffLimits {
+            tolerance,
+            ..DiffLimits::EXACT
+        };
+        encode_diff_within(&mut shown, &next, 0, limits, &mut out);
+        let mut terminal = prev.clone();
+        apply(&mut terminal, &out);
+        assert_eq!(looks(&terminal), looks(shown.as_ref().unwrap()));
+        let worst = (terminal.cells.iter().zip(&next.cells))
+            .map(|(a, b)| distance(a, b))
+            .max();
+        assert!(worst <= Some(u16::from(tolerance)), "{worst:?}");
+        let text = String::from_utf8_lossy(&out);
+        text.matches("\x1b[38;2;").count() + text.matches("\x1b[48;2;").count()
+    };
+    assert_eq!(sgrs(0), 40);
+    assert!(sgrs(8) <= 4, "{}", sgrs(8));
+}

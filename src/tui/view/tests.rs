@@ -45,12 +45,23 @@ fn over_a_budget_a_move_is_approximate_then_refines_to_exact() {
     assert!(s.approximate(), "a move over budget is sent approximately");
     assert!(first.len() < 1500 + 400, "{} bytes", first.len());
     let mut draws = 0;
+    let target = CellGrid::from_image(&s.image, ColorMode::TrueColor);
     while s.approximate() {
+        let before = s.shown.clone().unwrap();
         let bytes = s.draw(&a);
         assert!(
             !bytes.is_empty(),
             "an approximate screen always gets closer"
         );
+        // The refinement goes straight to within REFINE_TOLERANCE: no image cell it sends is
+        // further than that from the frame.
+        let after = s.shown.as_ref().unwrap();
+        for i in 0..target.cells.len() {
+            if after.cells[i] != before.cells[i] {
+                let d = distance(&after.cells[i], &target.cells[i]);
+                assert!(d <= u16::from(REFINE_TOLERANCE), "cell {i}: {d} off");
+            }
+        }
         draws += 1;
         assert!(draws < 100, "never exact");
     }
