@@ -55,18 +55,56 @@ impl Image {
     }
 
     /// Writes a PFM: linear little-endian f32 RGB, bottom row first, as the format requires.
+    /// The rows go out as they lie in memory (on a little-endian CPU, a row of `Vec3` is its
+    /// PFM bytes), in as few vectored writes as the writer takes: no copy, no per-pixel work.
     pub fn write_pfm(&self, mut w: impl Write) -> io::Result<()> {
         write!(w, "PF\n{} {}\n-1.0\n", self.width, self.height)?;
-        let mut buf = Vec::with_capacity(self.pixels.len() * 12);
-        for y in (0..self.height).rev() {
-            for x in 0..self.width {
-                for c in self.get(x, y).to_array() {
+        let width = self.width as usize;
+        if width == 0 {
+            return Ok(());
+        }
+        #[cfg(target_endian = "little")]
+        {
+            let rows: Vec<&[u8]> = self.pixels.chunks_exact(width).rev().map(bytes).collect();
+            let mut slices: Vec<io::IoSlice> = rows.iter().map(|r| io::IoSlice::new(r)).collect();
+            write_all_vectored(&mut w, &mut slices)
+        }
+        #[cfg(not(target_endian = "little"))]
+        {
+            let mut buf = Vec::with_capacity(self.pixels.len() * 12);
+            for row in self.pixels.chunks_exact(width).rev() {
+                for c in row.iter().flat_map(|p| p.to_array()) {
                     buf.extend_from_slice(&c.to_le_bytes());
                 }
             }
+            w.write_all(&buf)
         }
-        w.write_all(&buf)
     }
+}
+
+/// The bytes of `pixels` as they lie in memory: three `f32` each, no padding.
+#[cfg(target_endian = "little")]
+fn bytes(pixels: &[Vec3]) -> &[u8] {
+    const _: () = assert!(std::mem::size_of::<Vec3>() == 12 && std::mem::align_of::<Vec3>() == 4);
+    // SAFETY: `Vec3` is `repr(C)` of three `f32` (12 bytes, checked above), so a slice of them is
+    // `12·len` initialised bytes; `u8` has no alignment or validity requirement.
+    unsafe {
+        std::slice::from_raw_parts(pixels.as_ptr().cast::<u8>(), std::mem::size_of_val(pixels))
+    }
+}
+
+/// `Write::write_all` for a list of slices (the standard one is not stable yet): writes them
+/// all, in order, retrying interrupted and partial writes.
+fn write_all_vectored(w: &mut impl Write, mut slices: &mut [io::IoSlice<'_>]) -> io::Result<()> {
+    while !slices.is_empty() {
+        match w.write_vectored(slices) {
+            Ok(0) => return Err(io::ErrorKind::WriteZero.into()),
+            Ok(n) => io::IoSlice::advance_slices(&mut slices, n),
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(())
 }
 
 impl Image {
@@ -185,6 +223,36 @@ mod tests {
             *p = Vec3::new(i as f32, 0.5 * i as f32, -1.25);
         }
         assert_eq!(Image::read_pfm(&pfm(&img)).unwrap(), img);
+    }
+
+    /// A writer that takes at most 5 bytes a call, and is interrupted every third call.
+    struct Trickle(Vec<u8>, u32);
+
+    impl Write for Trickle {
+        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+            self.1 += 1;
+            if self.1.is_multiple_of(3) {
+                return Err(io::ErrorKind::Interrupted.into());
+            }
+            let n = buf.len().min(5);
+            self.0.extend_from_slice(&buf[..n]);
+            Ok(n)
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn pfm_survives_partial_and_interrupted_writes() {
+        let mut img = Image::new(7, 5);
+        for (i, p) in img.pixels.iter_mut().enumerate() {
+            *p = Vec3::new(i as f32, -(i as f32), 1.0 / (i as f32 + 1.0));
+        }
+        let mut out = Trickle(vec![], 0);
+        img.write_pfm(&mut out).unwrap();
+        assert_eq!(out.0, pfm(&img));
+        assert_eq!(Image::read_pfm(&out.0).unwrap(), img);
     }
 
     #[test]

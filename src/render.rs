@@ -9,13 +9,17 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::accel::Hit;
+use crate::accel::{Hit, TILE_RAYS, TileCache};
 use crate::camera::Camera;
 use crate::denoise::{GuidePixel, Guides, denoise};
 use crate::image::Image;
+use crate::rng::Rng;
 use crate::sampler::{SampleSource, Sampler, Stream};
 use crate::scene::{PointLight, Scene};
 use crate::shading::{RayCounts, Settings, Tracer};
+
+/// The side of a tile of camera rays traced together (`TILE`² = [`TILE_RAYS`]).
+const TILE: usize = 8;
 
 /// What a frame cost.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -80,15 +84,7 @@ pub fn render(
     width: u32,
     height: u32,
 ) -> Frame {
-    render_cached(
-        scene,
-        camera,
-        lights,
-        settings,
-        width,
-        height,
-        &mut HitCache::new(),
-    )
+    render_impl(scene, camera, lights, settings, width, height, None, false)
 }
 
 /// Renders a frame, reusing `cache`'s primary hits when they are still valid (one sample per
@@ -102,7 +98,16 @@ pub fn render_cached(
     height: u32,
     cache: &mut HitCache,
 ) -> Frame {
-    render_impl(scene, camera, lights, settings, width, height, cache, false)
+    render_impl(
+        scene,
+        camera,
+        lights,
+        settings,
+        width,
+        height,
+        Some(cache),
+        false,
+    )
 }
 
 /// [`render_cached`], and with path-traced indirect light the denoiser's guide buffers too
@@ -116,7 +121,16 @@ pub fn render_guided(
     height: u32,
     cache: &mut HitCache,
 ) -> Frame {
-    render_impl(scene, camera, lights, settings, width, height, cache, true)
+    render_impl(
+        scene,
+        camera,
+        lights,
+        settings,
+        width,
+        height,
+        Some(cache),
+        true,
+    )
 }
 
 /// One sample through `ray`. A path-traced frame's sample is split (the same colour either
@@ -149,7 +163,7 @@ fn render_impl(
     settings: &Settings,
     width: u32,
     height: u32,
-    cache: &mut HitCache,
+    mut cache: Option<&mut HitCache>,
     guided: bool,
 ) -> Frame {
     let start = Instant::now();
@@ -166,6 +180,7 @@ fn render_impl(
     let mut image = Image::new(width, height);
     // Path-traced frames split every sample for the denoiser (same colour, in any case).
     let split = tracer.splits();
+    let draws = tracer.draws_random_numbers();
     let mut guides = (guided && split).then(|| Guides {
         width,
         height,
@@ -190,33 +205,78 @@ fn render_impl(
 
     let key = Some((camera_key(camera), width, height));
     let counts = if samples == 1 {
-        let reuse = cache.key == key && cache.hits.len() == w * h;
-        if !reuse {
-            cache.hits.resize(w * h, None);
-        }
+        let reuse = cache
+            .as_ref()
+            .is_some_and(|c| c.key == key && c.hits.len() == w * h);
+        // The cache's rows by band, or none (a frame whose hits nobody keeps stores none).
+        let mut hit_bands: Vec<Option<&mut [Option<Hit>]>> = match cache.as_mut() {
+            Some(c) => {
+                if !reuse {
+                    c.hits.resize(w * h, None);
+                }
+                c.hits.chunks_mut(TILE * w).map(Some).collect()
+            }
+            None => (0..h.div_ceil(TILE)).map(|_| None).collect(),
+        };
+        // Bands of `TILE` rows, walked in tiles of `TILE`×`TILE` pixels: each tile's camera
+        // rays are traced together (`Scene::intersect_tile`), then shaded pixel by pixel.
         let counts = image
             .pixels
-            .par_chunks_mut(w)
-            .zip(cache.hits.par_chunks_mut(w))
-            .zip(guide_rows.par_iter_mut())
+            .par_chunks_mut(TILE * w)
+            .zip(hit_bands.par_iter_mut())
+            .zip(guide_rows.par_chunks_mut(TILE))
             .enumerate()
-            .map(|(y, ((row, hits), guide_row))| {
+            .map(|(band, ((pixels, hits), guide_rows))| {
                 let mut n = RayCounts::default();
-                for (x, (px, hit)) in row.iter_mut().zip(hits.iter_mut()).enumerate() {
-                    let ray = rays.ray(x as f32 + 0.5, y as f32 + 0.5);
-                    if !reuse {
-                        n.primary += 1;
-                        *hit = scene.intersect(&ray, f32::INFINITY);
+                let (y0, rows) = (band * TILE, guide_rows.len());
+                let mut tile_rays = Vec::with_capacity(TILE_RAYS);
+                let mut tile_hits = [None; TILE_RAYS];
+                let mut tile_cache = TileCache::default();
+                for x0 in (0..w).step_by(TILE) {
+                    let cols = (w - x0).min(TILE);
+                    tile_rays.clear();
+                    for dy in 0..rows {
+                        for x in x0..x0 + cols {
+                            let y = y0 + dy;
+                            tile_rays.push(rays.ray(x as f32 + 0.5, y as f32 + 0.5));
+                        }
                     }
-                    let mut rng =
-                        Stream::for_sample(sampler, (y * w + x) as u64, 0, 1, settings.frame);
-                    let g = guide_row.as_mut().map(|r| &mut r[x]);
-                    *px = sample(&tracer, &ray, *hit, &mut rng, &mut n, g);
+                    let k = tile_rays.len();
+                    if !reuse {
+                        n.primary += k as u64;
+                        scene.intersect_tile(
+                            &tile_rays,
+                            f32::INFINITY,
+                            &mut tile_hits[..k],
+                            &mut tile_cache,
+                        );
+                    }
+                    for (i, ray) in tile_rays.iter().enumerate() {
+                        let (dy, x) = (i / cols, x0 + i % cols);
+                        let at = dy * w + x;
+                        match hits {
+                            Some(h) if reuse => tile_hits[i] = h[at],
+                            Some(h) => h[at] = tile_hits[i],
+                            None => {}
+                        }
+                        let y = y0 + dy;
+                        // Only path-traced light draws random numbers: skip the hash otherwise.
+                        let mut rng = if draws {
+                            Stream::for_sample(sampler, (y * w + x) as u64, 0, 1, settings.frame)
+                        } else {
+                            Stream::Independent(Rng::seeded(0))
+                        };
+                        let g = guide_rows[dy].as_mut().map(|r| &mut r[x]);
+                        pixels[at] = sample(&tracer, ray, tile_hits[i], &mut rng, &mut n, g);
+                    }
                 }
                 n
             })
             .reduce(RayCounts::default, sum);
-        cache.key = key;
+        drop(hit_bands);
+        if let Some(c) = cache {
+            c.key = key;
+        }
         counts
     } else {
         let strata = (samples as f32).sqrt() as u32;
@@ -337,15 +397,7 @@ pub fn render_denoised(
     width: u32,
     height: u32,
 ) -> Frame {
-    let mut frame = render_guided(
-        scene,
-        camera,
-        lights,
-        settings,
-        width,
-        height,
-        &mut HitCache::new(),
-    );
+    let mut frame = render_impl(scene, camera, lights, settings, width, height, None, true);
     if let Some(g) = &frame.guides {
         let start = Instant::now();
         frame.image = denoise(g).image;

@@ -11,10 +11,10 @@ mod common;
 
 use common::{Rng, in_cube, log_uniform, uniform, unit};
 use glam::Vec3;
-use raytty::accel::Isa;
 use raytty::accel::box4::Box4;
 use raytty::accel::box8::Box8;
 use raytty::accel::tri4::{Hits, Tri4, hits as hits_in, hits2};
+use raytty::accel::{Isa, TileCache};
 use raytty::geometry::{Aabb, TriHit, intersect_watertight};
 use raytty::scene::procedural::displaced_icosphere;
 use raytty::{
@@ -323,6 +323,129 @@ fn structures_on_every_path_match_brute_force() {
         let rays = rays(seed, &tris, 1_000, 1.5 * scale, Vec3::ZERO);
         assert_structures_agree(&objects, &rays, &format!("soup at scale {scale}"));
     }
+}
+
+/// Tiles of rays from one origin (as the camera's): a grid of up to 8×8 directions around a
+/// vertex, an edge's midpoint or a random point of `tris`, spaced from 1e-7 to 0.3 of the
+/// distance, some with a ray exactly through a vertex (an edge function of 0) and some from
+/// an origin on a triangle's plane.
+fn tiles(
+    seed: u64,
+    tris: &[[Vec3; 3]],
+    n: usize,
+    reach: f32,
+    centre: Vec3,
+) -> Vec<(Vec<Ray>, f32)> {
+    let mut rng = Rng::seeded(seed);
+    (0..n)
+        .map(|i| {
+            let t = &tris[(rng.next_u64() % tris.len() as u64) as usize];
+            let k = (rng.next_u64() % 3) as usize;
+            let origin = match i % 7 {
+                // In the triangle's plane.
+                6 => t[k] + (t[k] - t[(k + 1) % 3]) * uniform(&mut rng, 0.5, 3.0),
+                _ => centre + in_cube(&mut rng, reach),
+            };
+            let target = match i % 3 {
+                0 => t[k],
+                1 => t[k] * 0.5 + t[(k + 1) % 3] * 0.5,
+                _ => centre + in_cube(&mut rng, reach),
+            };
+            let dist = (target - origin).length();
+            let spacing = log_uniform(&mut rng, -7.0, -0.5) * dist;
+            let (u, v) = (target - origin).normalize().any_orthonormal_pair();
+            let (w, h) = (1 + rng.next_u64() % 8, 1 + rng.next_u64() % 8);
+            let mut rays: Vec<Ray> = (0..h)
+                .flat_map(|y| {
+                    (0..w).map(move |x| (x as f32 - w as f32 / 2.0, y as f32 - h as f32 / 2.0))
+                })
+                .map(|(x, y)| target + u * (x * spacing) + v * (y * spacing) - origin)
+                .filter(|d| *d != Vec3::ZERO && d.is_finite())
+                .map(|d| Ray::new(origin, d))
+                .collect();
+            if i % 2 == 0 && t[k] != origin {
+                let l = (rng.next_u64() % rays.len().max(1) as u64) as usize;
+                let exact = Ray::new(origin, t[k] - origin);
+                if l < rays.len() {
+                    rays[l] = exact;
+                } else {
+                    rays.push(exact);
+                }
+            }
+            let t_max = if i % 5 == 0 {
+                uniform(&mut rng, 0.2, 1.5)
+            } else {
+                f32::INFINITY
+            };
+            (rays, t_max)
+        })
+        .collect()
+}
+
+/// `Scene::intersect_tile` on both structures and every path gives each ray of a tile the
+/// brute-force hit, bit for bit (`t`, barycentrics, index), one cache kept across all tiles.
+fn assert_tiles_agree(objects: &[Vec<[Vec3; 3]>], tiles: &[(Vec<Ray>, f32)], what: &str) {
+    let tris: Vec<[Vec3; 3]> = objects.concat();
+    for kind in [AccelKind::Flat, AccelKind::Bvh] {
+        let scene = scene_of(objects, kind);
+        for isa in paths() {
+            let s = scene.clone().with_isa(isa).expect("available");
+            let mut cache = TileCache::default();
+            for (i, (rays, t_max)) in tiles.iter().enumerate() {
+                let mut hits = vec![None; rays.len()];
+                s.intersect_tile(rays, *t_max, &mut hits, &mut cache);
+                for (r, (ray, got)) in rays.iter().zip(&hits).enumerate() {
+                    let want = brute_force(&tris, ray, *t_max);
+                    assert_eq!(
+                        got.map(|h| (h.t.to_bits(), h.b.map(f32::to_bits), h.triangle)),
+                        want.map(|h| (h.t.to_bits(), h.b.map(f32::to_bits), h.triangle)),
+                        "{what}: tile {i} ray {r} {ray:?} t_max {t_max}, {kind:?} on {isa:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn tiles_of_rays_on_every_path_match_brute_force() {
+    // At most 64 triangles: the flat list culls tiles triangle by triangle up to there.
+    for centre in [Vec3::ZERO, Vec3::splat(1e5)] {
+        let objects: Vec<Vec<[Vec3; 3]>> = icosphere(centre).concat()[..60]
+            .chunks(12)
+            .map(<[_]>::to_vec)
+            .collect();
+        let tris = objects.concat();
+        let tiles = tiles(21, &tris, 300, 0.7, centre);
+        assert_tiles_agree(&objects, &tiles, &format!("icosphere cap at {centre}"));
+    }
+    for (seed, scale) in [(22, 1e-15), (23, 1e-6), (24, 1.0), (25, 1e6), (26, 1e30)] {
+        let objects: Vec<Vec<[Vec3; 3]>> = soup(seed, 60, 1.0, 0.3, scale)
+            .chunks(10)
+            .map(<[_]>::to_vec)
+            .collect();
+        let tris = objects.concat();
+        let tiles = tiles(seed, &tris, 300, 1.5 * scale, Vec3::ZERO);
+        assert_tiles_agree(&objects, &tiles, &format!("soup at scale {scale}"));
+    }
+    let scene = cornell_box();
+    let objects: Vec<Vec<[Vec3; 3]>> = vec![scene.triangles().iter().map(|t| t.v).collect()];
+    let cam = scene.camera();
+    let mut rng = Rng::seeded(27);
+    let tiles: Vec<(Vec<Ray>, f32)> = (0..200)
+        .map(|_| {
+            let g = Camera {
+                position: cam.position + in_cube(&mut rng, 0.8),
+                yaw: uniform(&mut rng, -3.0, 3.0),
+                pitch: uniform(&mut rng, -1.0, 1.0),
+            }
+            .rays(64, 48);
+            let (x0, y0) = ((rng.next_u64() % 56) as f32, (rng.next_u64() % 40) as f32);
+            let rays = (0..64).map(|i| g.ray(x0 + (i % 8) as f32 + 0.5, y0 + (i / 8) as f32 + 0.5));
+            (rays.collect(), f32::INFINITY)
+        })
+        .collect();
+    assert_tiles_agree(&objects, &tiles, "cornell cameras");
 }
 
 #[test]

@@ -13,7 +13,13 @@ use super::isa::Isa;
 use super::tri4::{
     Closest, Kernel, LANES, Portable, RayLanes, Tri4, blocks_closest, blocks_occluded,
 };
+use glam::Vec3;
+
 use crate::geometry::{Aabb, Ray, Triangle};
+
+mod tile;
+
+pub use tile::{TILE_RAYS, TileCache};
 
 /// Objects sorted by entry distance on the stack; a list with more is visited in order.
 const SORTED_MAX: usize = 64;
@@ -33,6 +39,8 @@ pub struct Flat {
     blocks: Vec<Tri4>,
     /// Scene index of each lane of `blocks` (`u32::MAX` for padding).
     ids: Vec<u32>,
+    /// Every triangle with its scene index, in index order: what a tile is culled over.
+    tris: Vec<([Vec3; 3], u32)>,
 }
 
 impl Flat {
@@ -43,6 +51,7 @@ impl Flat {
             objects: vec![],
             blocks: vec![],
             ids: vec![],
+            tris: vec![],
         };
         let mut aabbs = vec![];
         for g in objects.iter().filter(|r| !r.is_empty()) {
@@ -51,6 +60,7 @@ impl Flat {
             f.blocks.extend(Tri4::pack(tris.iter().map(|t| t.v)));
             let n = f.blocks.len() - first;
             f.ids.extend(g.clone().map(|i| i as u32));
+            f.tris.extend(g.clone().map(|i| (triangles[i].v, i as u32)));
             f.ids.resize((first + n) * LANES, u32::MAX);
             f.objects.push(Object {
                 first: first as u32,
@@ -62,6 +72,7 @@ impl Flat {
             );
         }
         f.boxes = aabbs.chunks(4).map(Box4::new).collect();
+        f.tris.sort_by_key(|&(_, i)| i);
         f
     }
 
@@ -87,6 +98,34 @@ impl Flat {
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => closest::<super::tri4::Sse2>(self, ray, t_max),
             _ => closest::<Portable>(self, ray, t_max),
+        }
+    }
+
+    /// The closest hits of `rays` into `hits` (as many), each as [`Flat::intersect`] gives it,
+    /// on path `isa` (must be available). Rays that share their origin and axes (a tile of
+    /// camera rays, at most [`TILE_RAYS`]) are tested together.
+    pub fn intersect_tile(
+        &self,
+        isa: Isa,
+        rays: &[Ray],
+        t_max: f32,
+        hits: &mut [Option<Hit>],
+        cache: &mut TileCache,
+    ) {
+        debug_assert!(isa.available(), "{} is not available", isa.name());
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the caller passes an available path.
+            Isa::Avx2 => unsafe { tile_avx2(self, rays, t_max, hits, cache) },
+            #[cfg(target_arch = "x86_64")]
+            Isa::Sse2 => {
+                tile::intersect_tile::<super::tri4::Sse2>(self, rays, t_max, hits, cache, |r| {
+                    closest::<super::tri4::Sse2>(self, r, t_max)
+                })
+            }
+            _ => tile::intersect_tile::<Portable>(self, rays, t_max, hits, cache, |r| {
+                closest::<Portable>(self, r, t_max)
+            }),
         }
     }
 
@@ -130,6 +169,20 @@ impl Flat {
 #[target_feature(enable = "avx2")]
 unsafe fn closest_avx2(f: &Flat, ray: &Ray, t_max: f32) -> Option<Hit> {
     closest::<super::tri4::Avx2>(f, ray, t_max)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn tile_avx2(
+    f: &Flat,
+    rays: &[Ray],
+    t_max: f32,
+    hits: &mut [Option<Hit>],
+    cache: &mut TileCache,
+) {
+    tile::intersect_tile::<super::tri4::Avx2>(f, rays, t_max, hits, cache, |r| {
+        closest::<super::tri4::Avx2>(f, r, t_max)
+    });
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -30,6 +30,7 @@ use crate::geometry::{Ray, Triangle};
 use bvh::Bvh;
 use flat::Flat;
 
+pub use flat::{TILE_RAYS, TileCache};
 pub use hit::{CULL_SLACK, Hit, cull_bound, shrunk_t_max};
 pub use isa::Isa;
 
@@ -180,6 +181,26 @@ impl Accel {
         match &self.structure {
             Structure::Flat(flat) => flat.intersect(self.isa, ray, t_max),
             Structure::Bvh(bvh) => bvh.intersect_isa(self.isa, ray, t_max),
+        }
+    }
+
+    /// The closest hits of `rays` into `hits` (as many), each as [`Accel::intersect`] gives
+    /// it. The flat list tests rays that share origin and axes (a tile of camera rays, at most
+    /// [`TILE_RAYS`]) together, keeping what tiles of one camera share in `cache`.
+    pub fn intersect_tile(
+        &self,
+        rays: &[Ray],
+        t_max: f32,
+        hits: &mut [Option<Hit>],
+        cache: &mut TileCache,
+    ) {
+        match &self.structure {
+            Structure::Flat(flat) => flat.intersect_tile(self.isa, rays, t_max, hits, cache),
+            Structure::Bvh(bvh) => {
+                for (h, r) in hits.iter_mut().zip(rays) {
+                    *h = bvh.intersect(r, t_max);
+                }
+            }
         }
     }
 

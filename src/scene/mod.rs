@@ -14,7 +14,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::accel::{Accel, AccelKind, AccelStats, Hit, Isa};
+use crate::accel::{Accel, AccelKind, AccelStats, Hit, Isa, TileCache};
 use crate::camera::Camera;
 use crate::geometry::{Aabb, DegenerateTriangle, Ray, Triangle};
 use crate::sampler::Sampler;
@@ -324,6 +324,21 @@ impl Scene {
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         self.accel.intersect(ray, t_max)
+    }
+
+    /// The closest hits of `rays` into `hits` (as many), each as [`Scene::intersect`] gives
+    /// it; camera rays of one tile (sharing origin and axes, at most
+    /// [`crate::accel::TILE_RAYS`]) are tested together where the structure can, keeping what
+    /// tiles of one camera share in `cache` (start with `TileCache::default()`).
+    #[inline]
+    pub fn intersect_tile(
+        &self,
+        rays: &[Ray],
+        t_max: f32,
+        hits: &mut [Option<Hit>],
+        cache: &mut TileCache,
+    ) {
+        self.accel.intersect_tile(rays, t_max, hits, cache)
     }
 
     /// Whether anything blocks `ray` before `t_max`.

@@ -82,6 +82,12 @@ impl<'a> Tracer<'a> {
             && matches!(self.settings.effects.indirect, Indirect::PathTraced { .. })
     }
 
+    /// Whether shading draws random numbers at all: only path-traced indirect light does (a
+    /// frame without it may pass any generator, which is left untouched).
+    pub fn draws_random_numbers(&self) -> bool {
+        matches!(self.settings.effects.indirect, Indirect::PathTraced { .. })
+    }
+
     /// One sample along a primary ray, split for the denoiser (see [`SplitSample`]). Its
     /// colour equals [`Tracer::shade_primary`]'s in value; the random numbers are drawn in the
     /// same order.

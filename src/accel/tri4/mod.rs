@@ -24,6 +24,7 @@
 use glam::Vec3;
 
 use super::box4::Box4;
+use super::hit::Hit;
 use super::isa::Isa;
 use crate::geometry::Ray;
 
@@ -173,6 +174,80 @@ impl Hits {
     }
 }
 
+/// Up to eight rays that share an origin and axes, lane by lane (their shear): what the
+/// ray-lane kernels read. Unused lanes repeat lane 0.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+pub struct Rays8 {
+    shear: [[f32; 2 * LANES]; 3],
+    count: usize,
+}
+
+impl Rays8 {
+    /// The first eight of `rays` (at least one), which must share their axes.
+    #[inline]
+    pub fn new(rays: &[Ray]) -> Rays8 {
+        let mut shear = [[0.0; 2 * LANES]; 3];
+        for l in 0..2 * LANES {
+            let s = rays[if l < rays.len() { l } else { 0 }].shear();
+            for (row, v) in shear.iter_mut().zip(s) {
+                row[l] = v;
+            }
+        }
+        Rays8 {
+            shear,
+            count: rays.len().min(2 * LANES),
+        }
+    }
+
+    /// The mask of the lanes that hold a ray.
+    #[inline]
+    pub fn lanes(&self) -> u32 {
+        (1 << self.count) - 1
+    }
+}
+
+/// Each of eight rays' closest hit so far: `t` (∞ for none yet), barycentrics and triangle.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+pub struct Best8 {
+    t: [f32; 2 * LANES],
+    b: [[f32; 2 * LANES]; 3],
+    id: [u32; 2 * LANES],
+}
+
+impl Best8 {
+    /// No hit yet.
+    pub const NONE: Best8 = Best8 {
+        t: [f32::INFINITY; 2 * LANES],
+        b: [[0.0; 2 * LANES]; 3],
+        id: [u32::MAX; 2 * LANES],
+    };
+
+    /// Takes `(t, b)` on triangle `id` for lane `l` if it is nearer than the lane's best.
+    /// Triangles are offered in increasing order, so a tie keeps the lower index.
+    #[inline]
+    pub fn offer(&mut self, l: usize, t: f32, b: [f32; 3], id: u32) {
+        if t < self.t[l] {
+            self.t[l] = t;
+            for (row, w) in self.b.iter_mut().zip(b) {
+                row[l] = w;
+            }
+            self.id[l] = id;
+        }
+    }
+
+    /// Lane `l`'s closest hit.
+    #[inline]
+    pub fn hit(&self, l: usize) -> Option<Hit> {
+        (self.id[l] != u32::MAX).then(|| Hit {
+            t: self.t[l],
+            b: [self.b[0][l], self.b[1][l], self.b[2][l]],
+            triangle: self.id[l],
+        })
+    }
+}
+
 /// How a traversal tests blocks: one of the three paths, chosen by the type.
 pub(crate) trait Kernel {
     /// The hits in one block.
@@ -181,6 +256,18 @@ pub(crate) trait Kernel {
     fn two(a: &Tri4, b: &Tri4, ray: &Ray, r: &RayLanes, t_max: f32) -> Hits;
     /// Which of four boxes the ray meets before `t_max`, and where it enters them.
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]);
+    /// Triangle `id` (vertices `v`; `rel` relative to the rays' common origin in their axis
+    /// order) against up to eight `rays` at once (`packet`), folded into `best`. Returns the
+    /// lanes the caller must test with the scalar test (its `f64` redo).
+    fn rays(
+        v: &[Vec3; 3],
+        rel: &[[f32; 3]; 3],
+        rays: &[Ray],
+        packet: &Rays8,
+        t_max: f32,
+        id: u32,
+        best: &mut Best8,
+    ) -> u32;
 }
 
 /// The portable path.
@@ -198,6 +285,23 @@ impl Kernel for Portable {
     #[inline(always)]
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
         b.enter_portable(origin, inv_dir, t_max)
+    }
+    #[inline(always)]
+    fn rays(
+        v: &[Vec3; 3],
+        _: &[[f32; 3]; 3],
+        rays: &[Ray],
+        packet: &Rays8,
+        t_max: f32,
+        id: u32,
+        best: &mut Best8,
+    ) -> u32 {
+        for (l, ray) in rays.iter().enumerate().take(packet.count) {
+            if let Some(h) = crate::geometry::intersect_watertight(ray, v, t_max) {
+                best.offer(l, h.t, h.b, id);
+            }
+        }
+        0
     }
 }
 
@@ -218,6 +322,18 @@ impl Kernel for Sse2 {
     #[inline(always)]
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
         b.enter_sse2(origin, inv_dir, t_max)
+    }
+    #[inline(always)]
+    fn rays(
+        _: &[Vec3; 3],
+        rel: &[[f32; 3]; 3],
+        _: &[Ray],
+        packet: &Rays8,
+        t_max: f32,
+        id: u32,
+        best: &mut Best8,
+    ) -> u32 {
+        x86::rays_sse2(rel, packet, t_max, id, best) & packet.lanes()
     }
 }
 
@@ -241,6 +357,19 @@ impl Kernel for Avx2 {
     #[inline(always)]
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
         b.enter_sse2(origin, inv_dir, t_max)
+    }
+    #[inline(always)]
+    fn rays(
+        _: &[Vec3; 3],
+        rel: &[[f32; 3]; 3],
+        _: &[Ray],
+        packet: &Rays8,
+        t_max: f32,
+        id: u32,
+        best: &mut Best8,
+    ) -> u32 {
+        // SAFETY: `Avx2` is only instantiated behind a check that the CPU has AVX2.
+        unsafe { x86::rays_avx2(rel, packet, t_max, id, best) & packet.lanes() }
     }
 }
 

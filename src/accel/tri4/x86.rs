@@ -10,24 +10,53 @@
 
 use std::arch::x86_64::*;
 
-use super::{Hits, LANES, RayLanes, Tri4};
+use super::{Best8, Hits, LANES, RayLanes, Rays8, Tri4};
 use crate::geometry::gamma;
 
 /// The watertight test of one ray against every lane of `$load`'s triangles, with the
-/// operations of module `$o` (`V` lanes wide, `FULL` the mask of all lanes): evaluates to
-/// `(mask, redo, t, b0, b1, b2)`.
-macro_rules! watertight_lanes {
+/// operations of module `$o`: the ray's constants splatted, the vertices loaded.
+macro_rules! triangle_lanes {
     ($o:ident, $load:expr, $r:expr, $t_max:expr) => {{
         use $o::*;
         let r: &RayLanes = $r;
-        let t_max: f32 = $t_max;
         let [kx, ky, kz] = r.axes;
         let (ox, oy, oz) = (splat(r.origin[0]), splat(r.origin[1]), splat(r.origin[2]));
-        let (sx, sy, sz) = (splat(r.shear[0]), splat(r.shear[1]), splat(r.shear[2]));
-        // `RayFrame`: the vertices relative to the origin, sheared.
-        let (a0, b0, z0) = (sub($load(0, kx), ox), sub($load(0, ky), oy), sub($load(0, kz), oz));
-        let (a1, b1, z1) = (sub($load(1, kx), ox), sub($load(1, ky), oy), sub($load(1, kz), oz));
-        let (a2, b2, z2) = (sub($load(2, kx), ox), sub($load(2, ky), oy), sub($load(2, kz), oz));
+        // `RayFrame`: the vertices relative to the origin (then sheared in `watertight_lanes`).
+        let (a0, b0, z0) = (
+            sub($load(0, kx), ox),
+            sub($load(0, ky), oy),
+            sub($load(0, kz), oz),
+        );
+        let (a1, b1, z1) = (
+            sub($load(1, kx), ox),
+            sub($load(1, ky), oy),
+            sub($load(1, kz), oz),
+        );
+        let (a2, b2, z2) = (
+            sub($load(2, kx), ox),
+            sub($load(2, ky), oy),
+            sub($load(2, kz), oz),
+        );
+        watertight_lanes!(
+            $o,
+            [a0, b0, z0, a1, b1, z1, a2, b2, z2],
+            [splat(r.shear[0]), splat(r.shear[1]), splat(r.shear[2])],
+            splat($t_max)
+        )
+    }};
+}
+
+/// The watertight test lane by lane, with the operations of module `$o` (`V` lanes wide,
+/// `FULL` the mask of all lanes), from each lane's vertices relative to its ray's origin in the
+/// ray's axis order (`a`, `b`, `z` per vertex), its shear and its `t_max`: evaluates to
+/// `(mask, redo, t, b0, b1, b2, accepted)`, `accepted` the hit lanes as a vector mask.
+macro_rules! watertight_lanes {
+    ($o:ident, [$a0:expr, $b0:expr, $z0:expr, $a1:expr, $b1:expr, $z1:expr, $a2:expr, $b2:expr, $z2:expr],
+     [$sx:expr, $sy:expr, $sz:expr], $t_max:expr) => {{
+        use $o::*;
+        let (a0, b0, z0, a1, b1, z1, a2, b2, z2) = ($a0, $b0, $z0, $a1, $b1, $z1, $a2, $b2, $z2);
+        let (sx, sy, sz) = ($sx, $sy, $sz);
+        let t_max = $t_max;
         let (x0, y0) = (add(a0, mul(sx, z0)), add(b0, mul(sy, z0)));
         let (x1, y1) = (add(a1, mul(sx, z1)), add(b1, mul(sy, z1)));
         let (x2, y2) = (add(a2, mul(sx, z2)), add(b2, mul(sy, z2)));
@@ -43,7 +72,7 @@ macro_rules! watertight_lanes {
         let det = add(add(e0, e1), e2);
         let (zs0, zs1, zs2) = (mul(sz, z0), mul(sz, z1), mul(sz, z2));
         let t_scaled = add(add(mul(e0, zs0), mul(e1, zs1)), mul(e2, zs2));
-        let bound = mul(splat(t_max), det);
+        let bound = mul(t_max, det);
         // Rejected as the scalar test rejects, in its order: mixed signs, a zero or NaN det,
         // `t·det` outside (0, t_max·det] on det's side.
         let reject = or(
@@ -56,12 +85,12 @@ macro_rules! watertight_lanes {
         let redo = mask(any_zero);
         let pass = !mask(reject) & !redo & FULL;
         if pass == 0 {
-            (0, redo, zero, zero, zero, zero)
+            (0, redo, zero, zero, zero, zero, zero)
         } else {
             let one = splat(1.0);
             let inv_det = div(one, det);
             let t = mul(t_scaled, inv_det);
-            let below = lt(t, splat(t_max));
+            let below = lt(t, t_max);
             // `t_error_bound`.
             let (g2, g3, g5) = (splat(gamma(2)), splat(gamma(3)), splat(gamma(5)));
             let two = splat(2.0);
@@ -110,14 +139,18 @@ macro_rules! watertight_lanes {
                 ),
             );
             let beyond = gt(t, delta_t);
-            let hit = pass & mask(and(and(below, certain), beyond));
+            let accepted = andnot(
+                or(reject, any_zero),
+                and(and(below, certain), beyond),
+            );
             (
-                hit,
+                mask(accepted),
                 redo,
                 t,
                 mul(e0, inv_det),
                 mul(e1, inv_det),
                 mul(e2, inv_det),
+                accepted,
             )
         }
     }};
@@ -167,6 +200,16 @@ mod sse {
     #[inline(always)]
     pub fn or(a: V, b: V) -> V {
         unsafe { _mm_or_ps(a, b) }
+    }
+    /// `b` where `a` is clear.
+    #[inline(always)]
+    pub fn andnot(a: V, b: V) -> V {
+        unsafe { _mm_andnot_ps(a, b) }
+    }
+    /// `b` where `m` is set, else `a`.
+    #[inline(always)]
+    pub fn select(m: V, a: V, b: V) -> V {
+        unsafe { _mm_or_ps(_mm_and_ps(m, b), _mm_andnot_ps(m, a)) }
     }
     #[inline(always)]
     pub fn eq(a: V, b: V) -> V {
@@ -252,6 +295,18 @@ mod avx {
     pub fn or(a: V, b: V) -> V {
         _mm256_or_ps(a, b)
     }
+    /// `b` where `a` is clear.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn andnot(a: V, b: V) -> V {
+        _mm256_andnot_ps(a, b)
+    }
+    /// `b` where `m` is set, else `a`.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn select(m: V, a: V, b: V) -> V {
+        _mm256_blendv_ps(a, b, m)
+    }
     #[target_feature(enable = "avx2")]
     #[inline]
     pub fn eq(a: V, b: V) -> V {
@@ -295,7 +350,7 @@ pub fn hits_sse2(block: &Tri4, r: &RayLanes, t_max: f32) -> Hits {
     let v = &block.v;
     // SAFETY: SSE2 is part of every x86-64; each load reads a whole aligned `[f32; 4]`.
     let load = |i: usize, axis: usize| unsafe { _mm_load_ps(v[i][axis].as_ptr()) };
-    let (mask, redo, t, b0, b1, b2) = watertight_lanes!(sse, load, r, t_max);
+    let (mask, redo, t, b0, b1, b2, _) = triangle_lanes!(sse, load, r, t_max);
     let mut out = Hits { redo, ..Hits::NONE };
     if mask != 0 {
         out.mask = mask;
@@ -330,7 +385,7 @@ pub unsafe fn hits2_avx2(a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Hits {
         }
     }
     let load = |i: usize, axis: usize| load2(a, b, i, axis);
-    let (mask, redo, t, b0, b1, b2) = watertight_lanes!(avx, load, r, t_max);
+    let (mask, redo, t, b0, b1, b2, _) = triangle_lanes!(avx, load, r, t_max);
     let mut out = Hits { redo, ..Hits::NONE };
     if mask != 0 {
         out.mask = mask;
@@ -356,3 +411,92 @@ pub unsafe fn hits_avx2(block: &Tri4, r: &RayLanes, t_max: f32) -> Hits {
 }
 
 const _: () = assert!(LANES == 4);
+
+/// One triangle (`rel`: its vertices relative to the rays' common origin, in their axis
+/// order) against eight rays at once with AVX2, folded into `best` (lanes that hit it nearer
+/// than their best so far take it, as `id`). Returns the lanes to redo with the scalar test.
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[target_feature(enable = "avx2")]
+#[inline]
+pub unsafe fn rays_avx2(
+    rel: &[[f32; 3]; 3],
+    rays: &Rays8,
+    t_max: f32,
+    id: u32,
+    best: &mut Best8,
+) -> u32 {
+    use avx::*;
+    // SAFETY: every load and store reads or writes a whole 32-byte-aligned `[f32; 8]`.
+    let load = |p: &[f32; 8]| unsafe { _mm256_load_ps(p.as_ptr()) };
+    // (A closure: a `target_feature` function is not a `FnMut`.)
+    #[allow(clippy::redundant_closure)]
+    let [[a0, b0, z0], [a1, b1, z1], [a2, b2, z2]] = rel.map(|v| v.map(|x| splat(x)));
+    let (mask, redo, t, w0, w1, w2, accepted) = watertight_lanes!(
+        avx,
+        [a0, b0, z0, a1, b1, z1, a2, b2, z2],
+        [
+            load(&rays.shear[0]),
+            load(&rays.shear[1]),
+            load(&rays.shear[2])
+        ],
+        splat(t_max)
+    );
+    if mask != 0 {
+        let best_t = load(&best.t);
+        let take = and(accepted, lt(t, best_t));
+        // SAFETY: as above; the ids are moved as bits.
+        unsafe {
+            let ids = _mm256_castsi256_ps(_mm256_load_si256(best.id.as_ptr().cast()));
+            _mm256_store_ps(best.t.as_mut_ptr(), select(take, best_t, t));
+            for (b, w) in best.b.iter_mut().zip([w0, w1, w2]) {
+                _mm256_store_ps(b.as_mut_ptr(), select(take, load(b), w));
+            }
+            let id = _mm256_castsi256_ps(_mm256_set1_epi32(id as i32));
+            let ids = _mm256_castps_si256(select(take, ids, id));
+            _mm256_store_si256(best.id.as_mut_ptr().cast(), ids);
+        }
+    }
+    redo
+}
+
+/// [`rays_avx2`] with SSE2, four lanes at a time.
+#[inline(always)]
+pub fn rays_sse2(rel: &[[f32; 3]; 3], rays: &Rays8, t_max: f32, id: u32, best: &mut Best8) -> u32 {
+    use sse::*;
+    let [[a0, b0, z0], [a1, b1, z1], [a2, b2, z2]] = rel.map(|v| v.map(splat));
+    let mut redo_all = 0;
+    for half in [0, LANES] {
+        // SAFETY: every load and store reads or writes four of eight `f32`s, 16-byte aligned.
+        let load = |p: &[f32; 8]| unsafe { _mm_load_ps(p[half..].as_ptr()) };
+        let (mask, redo, t, w0, w1, w2, accepted) = watertight_lanes!(
+            sse,
+            [a0, b0, z0, a1, b1, z1, a2, b2, z2],
+            [
+                load(&rays.shear[0]),
+                load(&rays.shear[1]),
+                load(&rays.shear[2])
+            ],
+            splat(t_max)
+        );
+        redo_all |= redo << half;
+        if mask != 0 {
+            let best_t = load(&best.t);
+            let take = and(accepted, lt(t, best_t));
+            // SAFETY: as above; the ids are moved as bits.
+            unsafe {
+                let ids = _mm_castsi128_ps(_mm_load_si128(best.id[half..].as_ptr().cast()));
+                _mm_store_ps(best.t[half..].as_mut_ptr(), select(take, best_t, t));
+                for (b, w) in best.b.iter_mut().zip([w0, w1, w2]) {
+                    let old = _mm_load_ps(b[half..].as_ptr());
+                    _mm_store_ps(b[half..].as_mut_ptr(), select(take, old, w));
+                }
+                let id = _mm_castsi128_ps(_mm_set1_epi32(id as i32));
+                let ids = _mm_castps_si128(select(take, ids, id));
+                _mm_store_si128(best.id[half..].as_mut_ptr().cast(), ids);
+            }
+        }
+    }
+    redo_all
+}

@@ -1,0 +1,231 @@
+//! Tiles of camera rays through the flat list: rays that share an origin and axes, tested a
+//! triangle at a time against eight rays at once, after a cull that drops the triangles no
+//! ray of the tile can hit.
+//!
+//! # The same hits as one ray at a time
+//!
+//! Each ray's answer is what testing every triangle gives (the smallest `t`, ties to the lowest
+//! index, each triangle tested with the query's `t_max`), as the per-ray query's is: the
+//! ray-lane kernels run the scalar test's operations lane by lane, triangles are taken in
+//! index order, and a lane keeps a new hit only when it is strictly nearer. The cull may only
+//! drop a triangle the scalar test rejects for every ray of the tile, by its sign test:
+//!
+//! With the rays' common origin `o`, a vertex relative to it, `(a, b, z) = v − o` in the rays'
+//! axis order, is the same `f32` for every ray, and only the shear `(sx, sy)` varies. In exact
+//! arithmetic on those values, edge function `eᵢ = xⱼ·yₖ − yⱼ·xₖ` with `x = a + sx·z`,
+//! `y = b + sy·z` is affine in `(sx, sy)` (the `sx·sy` terms cancel):
+//! `eᵢ = (aⱼbₖ − bⱼaₖ) + sx·(zⱼbₖ − bⱼzₖ) + sy·(aⱼzₖ − zⱼaₖ)`, so over the box of the tile's
+//! shears its extremes are at the corners. The scalar test's `eᵢ` (in `f32`, or redone in `f64`)
+//! is within `EdgeErrors`' bound of that exact value; the cull uses four times that bound,
+//! taken over the whole box, plus an absolute term for underflow. If some `eᵢ` is below minus
+//! that margin over the whole box and some `eⱼ` above it, every ray of the tile computes mixed
+//! signs, which the scalar test rejects: the triangle is dropped. Anything else (a margin that
+//! is not finite, a tile whose rays do not share origin and axes) keeps the triangle or falls
+//! back to one ray at a time.
+
+use glam::Vec3;
+
+use super::Flat;
+use crate::accel::hit::Hit;
+use crate::accel::tri4::{Best8, Kernel, Rays8};
+use crate::geometry::{Ray, gamma, intersect_watertight};
+
+/// Most rays in one tile.
+pub const TILE_RAYS: usize = 64;
+
+/// Flat lists of more triangles than this answer tiles one ray at a time: the cull looks at
+/// every triangle once per tile, which pays while triangles are few.
+const TILE_TRIANGLES: usize = 64;
+
+const _: () = assert!(TILE_TRIANGLES <= 256, "kept triangles are indexed by a u8");
+
+/// What the flat list keeps between tiles of one camera: each triangle relative to the rays'
+/// common origin, with its edge functions' affine coefficients and cull margins. Start with
+/// `TileCache::default()` and pass the same one for every tile of a frame (or of a band).
+#[derive(Clone, Debug, Default)]
+pub struct TileCache {
+    /// The origin (bits) and axes the triangles are relative to.
+    key: Option<([u32; 3], [usize; 3])>,
+    /// The largest |sx|, |sy| the margins hold for.
+    bound: (f32, f32),
+    tris: Vec<TileTri>,
+}
+
+/// One triangle as the cull sees it.
+#[derive(Clone, Copy, Debug)]
+struct TileTri {
+    /// Vertices relative to the origin, in the rays' axis order.
+    rel: [[f32; 3]; 3],
+    v: [Vec3; 3],
+    id: u32,
+    /// Per edge: `e = c + sx·p + sy·q` in exact arithmetic.
+    c: [f64; 3],
+    p: [f64; 3],
+    q: [f64; 3],
+    /// Per edge: the bound on the scalar test's error in `e` for any shear within `bound`
+    /// (times four); NaN when not finite (then the triangle is never culled).
+    margin: [f64; 3],
+}
+
+/// The smallest power of two ≥ `x` (for `x` ≥ 0, finite), so that the margins are rebuilt
+/// only a few times per frame.
+fn power_of_two_above(x: f32) -> f32 {
+    let x = x.max(f32::MIN_POSITIVE);
+    f32::from_bits((x.to_bits() + 0x7f_ffff) & 0xff80_0000)
+}
+
+impl TileCache {
+    /// Makes the cache hold `f`'s triangles relative to `origin` with `axes`, with margins for
+    /// shears up to at least (`smx`, `smy`).
+    fn prepare(&mut self, f: &Flat, origin: Vec3, axes: [usize; 3], smx: f32, smy: f32) {
+        let key = Some((origin.to_array().map(f32::to_bits), axes));
+        if self.key == key && smx <= self.bound.0 && smy <= self.bound.1 {
+            return;
+        }
+        if self.key != key {
+            self.bound = (0.0, 0.0);
+        }
+        self.key = key;
+        self.bound = (
+            power_of_two_above(smx.max(self.bound.0)),
+            power_of_two_above(smy.max(self.bound.1)),
+        );
+        let [kx, ky, kz] = axes;
+        let (smx, smy) = (self.bound.0 as f64, self.bound.1 as f64);
+        self.tris.clear();
+        self.tris.extend(f.tris.iter().map(|&(v, id)| {
+            let rel = [0, 1, 2].map(|j| {
+                let d = v[j] - origin;
+                [d[kx], d[ky], d[kz]]
+            });
+            let mut t = TileTri {
+                rel,
+                v,
+                id,
+                c: [0.0; 3],
+                p: [0.0; 3],
+                q: [0.0; 3],
+                margin: [0.0; 3],
+            };
+            edges(&rel, smx, smy, &mut t);
+            t
+        }));
+    }
+}
+
+/// Fills `t`'s edge coefficients and margins for shears up to (`smx`, `smy`) in magnitude.
+fn edges(rel: &[[f32; 3]; 3], smx: f64, smy: f64, t: &mut TileTri) {
+    let (g2, g5) = (gamma(2) as f64, gamma(5) as f64);
+    // The smallest subnormal `f32`: the absolute error of an operation that underflows.
+    let tiny = f32::from_bits(1) as f64;
+    let a = rel.map(|v| v[0] as f64);
+    let b = rel.map(|v| v[1] as f64);
+    let z = rel.map(|v| v[2] as f64);
+    // Bounds on |x|, |y| over the shears and on their rounding errors.
+    let xm = [0, 1, 2].map(|j| a[j].abs() + smx * z[j].abs());
+    let ym = [0, 1, 2].map(|j| b[j].abs() + smy * z[j].abs());
+    let dx = [0, 1, 2].map(|j| g5 * (xm[j] + 2.0 * smx * z[j].abs()) + 2.0 * tiny);
+    let dy = [0, 1, 2].map(|j| g5 * (ym[j] + 2.0 * smy * z[j].abs()) + 2.0 * tiny);
+    for (i, (j, k)) in [(1, 2), (2, 0), (0, 1)].into_iter().enumerate() {
+        t.c[i] = a[j] * b[k] - b[j] * a[k];
+        t.p[i] = z[j] * b[k] - b[j] * z[k];
+        t.q[i] = a[j] * z[k] - z[j] * a[k];
+        let margin = 4.0
+            * (xm[j] * dy[k]
+                + ym[k] * dx[j]
+                + ym[j] * dx[k]
+                + xm[k] * dy[j]
+                + g2 * (xm[j] * ym[k] + ym[j] * xm[k]))
+            + 4.0 * tiny;
+        let finite =
+            margin.is_finite() && t.c[i].is_finite() && t.p[i].is_finite() && t.q[i].is_finite();
+        t.margin[i] = if finite { margin } else { f64::NAN };
+    }
+}
+
+/// Whether a ray whose shear lies in the box `sx` × `sy` may pass the sign test of `t`. `false`
+/// only when the scalar test computes mixed signs for every such ray (see the module's doc).
+#[inline(always)]
+fn may_hit(t: &TileTri, sx: (f64, f64), sy: (f64, f64)) -> bool {
+    let (mut neg, mut pos) = (false, false);
+    for i in 0..3 {
+        let (p, q) = (t.p[i], t.q[i]);
+        let (px0, px1, qy0, qy1) = (sx.0 * p, sx.1 * p, sy.0 * q, sy.1 * q);
+        let lo = t.c[i] + px0.min(px1) + qy0.min(qy1);
+        let hi = t.c[i] + px0.max(px1) + qy0.max(qy1);
+        // A NaN margin (or bound) makes both false: kept.
+        neg |= hi < -t.margin[i];
+        pos |= lo > t.margin[i];
+    }
+    !(neg && pos)
+}
+
+/// The closest hits of `rays` (at most [`TILE_RAYS`], sharing origin and axes, else answered
+/// one at a time by `one`) into `hits`, each as [`Flat::intersect`] gives it.
+#[inline(always)]
+pub(super) fn intersect_tile<K: Kernel>(
+    f: &Flat,
+    rays: &[Ray],
+    t_max: f32,
+    hits: &mut [Option<Hit>],
+    cache: &mut TileCache,
+    one: impl Fn(&Ray) -> Option<Hit>,
+) {
+    debug_assert_eq!(rays.len(), hits.len());
+    let Some(first) = rays.first() else { return };
+    let (origin, axes) = (first.origin, first.axes());
+    if rays.len() > TILE_RAYS
+        || f.tris.len() > TILE_TRIANGLES
+        || rays.iter().any(|r| r.origin != origin || r.axes() != axes)
+    {
+        for (h, r) in hits.iter_mut().zip(rays) {
+            *h = one(r);
+        }
+        return;
+    }
+    // The box of the tile's shears.
+    let (mut sx, mut sy) = (
+        (f32::INFINITY, f32::NEG_INFINITY),
+        (f32::INFINITY, f32::NEG_INFINITY),
+    );
+    for r in rays {
+        let [x, y, _] = r.shear();
+        sx = (sx.0.min(x), sx.1.max(x));
+        sy = (sy.0.min(y), sy.1.max(y));
+    }
+    cache.prepare(
+        f,
+        origin,
+        axes,
+        sx.0.abs().max(sx.1.abs()),
+        sy.0.abs().max(sy.1.abs()),
+    );
+    let (sx, sy) = ((sx.0 as f64, sx.1 as f64), (sy.0 as f64, sy.1 as f64));
+    // The triangles that survive the cull, in index order.
+    let mut kept = [0u8; TILE_TRIANGLES];
+    let mut n = 0;
+    for (i, t) in cache.tris.iter().enumerate() {
+        if may_hit(t, sx, sy) {
+            kept[n] = i as u8;
+            n += 1;
+        }
+    }
+    for (rays, hits) in rays.chunks(8).zip(hits.chunks_mut(8)) {
+        let packet = Rays8::new(rays);
+        let mut best = Best8::NONE;
+        for &i in &kept[..n] {
+            let t = &cache.tris[i as usize];
+            let mut redo = K::rays(&t.v, &t.rel, rays, &packet, t_max, t.id, &mut best);
+            while redo != 0 {
+                let l = redo.trailing_zeros() as usize;
+                redo &= redo - 1;
+                if let Some(h) = intersect_watertight(&rays[l], &t.v, t_max) {
+                    best.offer(l, h.t, h.b, t.id);
+                }
+            }
+        }
+        for (l, h) in hits.iter_mut().enumerate() {
+            *h = best.hit(l);
+        }
+    }
+}
