@@ -181,6 +181,8 @@ fn render_impl(
     // Path-traced frames split every sample for the denoiser (same colour, in any case).
     let split = tracer.splits();
     let draws = tracer.draws_random_numbers();
+    // Frames without path-traced light shade a tile at a time (the same colours).
+    let by_tile = tracer.shades_tiles();
     let mut guides = (guided && split).then(|| Guides {
         width,
         height,
@@ -231,6 +233,7 @@ fn render_impl(
                 let (y0, rows) = (band * TILE, guide_rows.len());
                 let mut tile_rays = Vec::with_capacity(TILE_RAYS);
                 let mut tile_hits = [None; TILE_RAYS];
+                let mut tile_colours = [Vec3::ZERO; TILE_RAYS];
                 let mut tile_cache = TileCache::default();
                 for x0 in (0..w).step_by(TILE) {
                     let cols = (w - x0).min(TILE);
@@ -251,14 +254,25 @@ fn render_impl(
                             &mut tile_cache,
                         );
                     }
-                    for (i, ray) in tile_rays.iter().enumerate() {
-                        let (dy, x) = (i / cols, x0 + i % cols);
-                        let at = dy * w + x;
+                    for (i, _) in tile_rays.iter().enumerate() {
+                        let at = i / cols * w + x0 + i % cols;
                         match hits {
                             Some(h) if reuse => tile_hits[i] = h[at],
                             Some(h) => h[at] = tile_hits[i],
                             None => {}
                         }
+                    }
+                    if by_tile {
+                        let colours = &mut tile_colours[..k];
+                        tracer.shade_tile(&tile_rays, &tile_hits[..k], colours, &mut n);
+                        for (i, c) in colours.iter().enumerate() {
+                            pixels[i / cols * w + x0 + i % cols] = *c;
+                        }
+                        continue;
+                    }
+                    for (i, ray) in tile_rays.iter().enumerate() {
+                        let (dy, x) = (i / cols, x0 + i % cols);
+                        let at = dy * w + x;
                         let y = y0 + dy;
                         // Only path-traced light draws random numbers: skip the hash otherwise.
                         let mut rng = if draws {

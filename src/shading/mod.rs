@@ -288,35 +288,138 @@ impl<'a> Tracer<'a> {
     pub fn direct(&self, p: glam::Vec3, err: Vec3, normal: Vec3, n: &mut RayCounts) -> Vec3 {
         let mut sum = Vec3::ZERO;
         for light in self.lights {
-            // A dark light adds nothing: no shadow ray for it.
-            if light.power == Vec3::ZERO {
+            let Some((term, shadow)) = self.light_term(light, p, err, normal) else {
+                continue;
+            };
+            if let Some(ray) = shadow {
+                n.shadow += 1;
+                if self.scene.occluded(&ray, 1.0 - SHADOW_EPSILON) {
+                    continue;
+                }
+            }
+            sum += term;
+        }
+        sum
+    }
+
+    /// What `light` adds to [`Tracer::direct`] at `p` if nothing blocks it, and the shadow ray
+    /// that decides whether something does (`None`: no ray is traced, the light counts as
+    /// seen). `None` for a light that adds nothing: dark, at `p`, or behind the surface.
+    #[inline(always)]
+    fn light_term(
+        &self,
+        light: &PointLight,
+        p: Vec3,
+        err: Vec3,
+        normal: Vec3,
+    ) -> Option<(Vec3, Option<Ray>)> {
+        // A dark light adds nothing: no shadow ray for it.
+        if light.power == Vec3::ZERO {
+            return None;
+        }
+        let to_light = light.position - p;
+        let dist2 = to_light.length_squared();
+        if !(dist2 > 0.0) {
+            return None;
+        }
+        let cos = normal.dot(to_light) / dist2.sqrt();
+        if !(cos > 0.0) {
+            return None;
+        }
+        let term = light.power * cos / (4.0 * PI * dist2.max(self.min_r2));
+        if !self.settings.effects.shadows {
+            return Some((term, None));
+        }
+        let origin = offset_ray_origin(p, err, normal, to_light);
+        let dir = light.position - origin;
+        let shadow = (dir != Vec3::ZERO && dir.is_finite()).then(|| Ray::new(origin, dir));
+        Some((term, shadow))
+    }
+
+    /// Whether [`Tracer::shade_tile`] can shade this frame's primary hits: one sample, light
+    /// that is not path traced.
+    pub fn shades_tiles(&self) -> bool {
+        !self.draws_random_numbers()
+    }
+
+    /// [`Tracer::shade_primary`] for a tile of primary rays and their hits (at most
+    /// [`crate::accel::TILE_RAYS`]), into `out`: the same colours bit for bit and the same rays
+    /// counted, computed light by light across the tile (each pixel's terms still added in the
+    /// lights' order), so that the tile's shadow rays are traced together, not interleaved
+    /// with shading. Only for frames that [`Tracer::shades_tiles`].
+    pub fn shade_tile(
+        &self,
+        rays: &[Ray],
+        hits: &[Option<Hit>],
+        out: &mut [Vec3],
+        n: &mut RayCounts,
+    ) {
+        debug_assert!(self.shades_tiles());
+        const MAX: usize = crate::accel::TILE_RAYS;
+        assert!(rays.len() <= MAX && hits.len() == rays.len() && out.len() == rays.len());
+        // Per pixel being shaded here: the hit point, its error, the normal facing the ray.
+        let mut at = [(Vec3::ZERO, Vec3::ZERO, Vec3::ZERO); MAX];
+        let mut sum = [Vec3::ZERO; MAX];
+        let mut here = [0u8; MAX];
+        let mut k = 0;
+        for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+            let Some(hit) = hit else {
+                out[i] = Vec3::ZERO;
+                continue;
+            };
+            let tri = &self.scene.triangles()[hit.triangle as usize];
+            let material = &self.scene.materials()[tri.material as usize];
+            let mode = self.settings.mode;
+            // As `shade`: flat colour; a black surface or a mirror (shaded one at a time).
+            let own = mode == Mode::Irradiance
+                || (mode == Mode::Colour
+                    && !(material.mirror > 0.0)
+                    && material.colour != Vec3::ZERO);
+            if !own {
+                out[i] = self.shade_primary(ray, Some(*hit), &mut crate::rng::Rng::seeded(0), n);
                 continue;
             }
-            let to_light = light.position - p;
-            let dist2 = to_light.length_squared();
-            if !(dist2 > 0.0) {
-                continue;
+            let (p, err) = hit_point(&tri.v, hit.b);
+            let normal = if tri.normal.dot(ray.dir) > 0.0 {
+                -tri.normal
+            } else {
+                tri.normal
+            };
+            at[k] = (p, err, normal);
+            here[k] = i as u8;
+            k += 1;
+        }
+        let mut terms = [None; MAX];
+        for light in self.lights {
+            for (t, &(p, err, normal)) in terms.iter_mut().zip(&at[..k]) {
+                *t = self.light_term(light, p, err, normal);
             }
-            let cos = normal.dot(to_light) / dist2.sqrt();
-            if !(cos > 0.0) {
-                continue;
-            }
-            if self.settings.effects.shadows {
-                let origin = offset_ray_origin(p, err, normal, to_light);
-                let dir = light.position - origin;
-                if dir != Vec3::ZERO && dir.is_finite() {
+            for (s, t) in sum.iter_mut().zip(&terms[..k]) {
+                let Some((term, shadow)) = t else { continue };
+                if let Some(ray) = shadow {
                     n.shadow += 1;
-                    if self
-                        .scene
-                        .occluded(&Ray::new(origin, dir), 1.0 - SHADOW_EPSILON)
-                    {
+                    if self.scene.occluded(ray, 1.0 - SHADOW_EPSILON) {
                         continue;
                     }
                 }
+                *s += *term;
             }
-            sum += light.power * cos / (4.0 * PI * dist2.max(self.min_r2));
         }
-        sum
+        for j in 0..k {
+            let i = here[j] as usize;
+            out[i] = if self.settings.mode == Mode::Irradiance {
+                sum[j]
+            } else {
+                let tri = &self.scene.triangles()[hits[i].expect("a hit").triangle as usize];
+                let material = &self.scene.materials()[tri.material as usize];
+                let indirect = match self.settings.effects.indirect {
+                    Indirect::Constant(k) => Vec3::splat(k),
+                    _ => Vec3::ZERO,
+                };
+                material.colour * (sum[j] + indirect)
+            };
+            debug_assert!(out[i].is_finite(), "non-finite colour {}", out[i]);
+        }
     }
 }
 
@@ -325,7 +428,27 @@ pub(crate) fn cosine_sample(n: Vec3, rng: &mut impl SampleSource) -> Vec3 {
     let [u1, u2] = rng.next_2d();
     let r = u1.sqrt();
     let phi = 2.0 * PI * u2;
-    let (s, c) = (libm::sinf(phi), libm::cosf(phi));
+    // One range reduction for both; the same bits as `sinf` and `cosf` apart for every angle
+    // a sample can give (checked for all 2²⁴ of them below).
+    let (s, c) = libm::sincosf(phi);
     let (t, b) = n.any_orthonormal_pair();
     (t * (r * c) + b * (r * s) + n * (1.0 - u1).max(0.0).sqrt()).normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use std::f32::consts::PI;
+
+    /// `libm::sincosf` gives `sinf`'s and `cosf`'s bits for every angle `cosine_sample` can be
+    /// given: samplers hand out multiples of 2⁻²⁴, all 2²⁴ of which are tried. (Frames, and
+    /// the bench's cached references, were made with the two apart.)
+    #[test]
+    fn sincos_is_sin_and_cos_for_every_sample_angle() {
+        for k in 0..1u32 << 24 {
+            let phi = 2.0 * PI * (k as f32 * (1.0 / (1u32 << 24) as f32));
+            let (s, c) = libm::sincosf(phi);
+            assert_eq!(s.to_bits(), libm::sinf(phi).to_bits(), "sin at {k}");
+            assert_eq!(c.to_bits(), libm::cosf(phi).to_bits(), "cos at {k}");
+        }
+    }
 }
