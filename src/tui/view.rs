@@ -109,6 +109,12 @@ const TOLERANCES: [u8; 5] = [0, 8, 16, 32, 64];
 /// 200×50, cost 14-18 B a cell exact and 6-8, 5-6, 4-6, 3-5 within 8, 16, 32, 64 levels
 /// (coarser colours are shared by more cells).
 const CELL_BYTES: [usize; 5] = [18, 7, 6, 5, 4];
+/// A tolerance is taken if its cells fit in this many frames' budgets (exact: in one). A frame
+/// the budget cuts short is continued by the next at no extra cost, whereas a coarser
+/// tolerance sends most cells twice (coarse, then within 8). 120×40 W held over 1 Mbit/s
+/// (`examples/slow_link`), within 8 levels after the release: 1 frame 0.14-0.16 s, 4 frames
+/// 0.09-0.10 s, any number (always 8) 0.10 s but 200×50 0.15-0.24 s (4: 0.16-0.17 s).
+const APPROXIMATE_FRAMES: usize = 4;
 /// Once the app stops changing, the first refinement goes straight to this tolerance (a
 /// ladder of coarser ones would send most cells again at each rung), then to exact.
 const REFINE_TOLERANCE: u8 = 8;
@@ -367,9 +373,10 @@ impl Screen {
 }
 
 /// The smallest of [`TOLERANCES`] whose cells to send (those of `next` further than it from
-/// `shown`) fit in `max_bytes` at [`CELL_BYTES`] each, else the largest (the budget then cuts
-/// the frame short); when `refining` (`next` is the frame the last draw approximated), at most
-/// [`REFINE_TOLERANCE`]. Exact when the screen is unknown (a first frame or a new size).
+/// `shown`) fit in `max_bytes` at [`CELL_BYTES`] each (the approximate ones in
+/// [`APPROXIMATE_FRAMES`] frames: the budget cuts the frame short), else the largest; when
+/// `refining` (`next` is the frame the last draw approximated), at most [`REFINE_TOLERANCE`].
+/// Exact when the screen is unknown (a first frame or a new size).
 fn tolerance_for(
     shown: Option<&CellGrid>,
     next: &CellGrid,
@@ -390,7 +397,10 @@ fn tolerance_for(
             *n += usize::from(d > u16::from(t));
         }
     }
-    let fits = |i: usize| beyond[i] * CELL_BYTES[i] <= max_bytes;
+    let fits = |i: usize| {
+        let frames = if i == 0 { 1 } else { APPROXIMATE_FRAMES };
+        beyond[i] * CELL_BYTES[i] <= max_bytes * frames
+    };
     let mut i = (0..TOLERANCES.len())
         .find(|&i| fits(i))
         .unwrap_or(TOLERANCES.len() - 1);
