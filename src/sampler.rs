@@ -165,9 +165,11 @@ impl Sobol {
     fn pair(&self, dimension: u32) -> [f32; 2] {
         let (shuffle, sx) = self.seeds(dimension);
         let i = upward_hash(self.index_reversed, shuffle).reverse_bits();
-        let x = upward_hash(i, sx).reverse_bits();
-        let y = upward_hash(sobol_1_reversed(i), second_seed(sx)).reverse_bits();
-        [unit(x), unit(y)]
+        let x = upward_hash(i, sx);
+        let y = upward_hash(sobol_1_reversed(i), second_seed(sx));
+        // Both turned back at once: one 64-bit reversal costs what one of 32 bits does.
+        let xy = ((u64::from(x) << 32) | u64::from(y)).reverse_bits();
+        [unit(xy as u32), unit((xy >> 32) as u32)]
     }
 }
 
