@@ -16,7 +16,7 @@ use crate::image::Image;
 use crate::rng::Rng;
 use crate::sampler::{SampleSource, Sampler, Stream};
 use crate::scene::{PointLight, Scene};
-use crate::shading::{RayCounts, Settings, Tracer};
+use crate::shading::{RayCounts, Settings, TileScratch, Tracer};
 
 /// The side of a tile of camera rays traced together (`TILE`² = [`TILE_RAYS`]).
 const TILE: usize = 8;
@@ -234,15 +234,13 @@ fn render_impl(
                 let mut tile_rays = Vec::with_capacity(TILE_RAYS);
                 let mut tile_hits = [None; TILE_RAYS];
                 let mut tile_colours = [Vec3::ZERO; TILE_RAYS];
+                let mut scratch = TileScratch::default();
                 let mut tile_cache = TileCache::default();
                 for x0 in (0..w).step_by(TILE) {
                     let cols = (w - x0).min(TILE);
                     tile_rays.clear();
                     for dy in 0..rows {
-                        for x in x0..x0 + cols {
-                            let y = y0 + dy;
-                            tile_rays.push(rays.ray(x as f32 + 0.5, y as f32 + 0.5));
-                        }
+                        rays.row(x0, cols, y0 + dy, &mut tile_rays);
                     }
                     let k = tile_rays.len();
                     if !reuse {
@@ -264,7 +262,13 @@ fn render_impl(
                     }
                     if by_tile {
                         let colours = &mut tile_colours[..k];
-                        tracer.shade_tile(&tile_rays, &tile_hits[..k], colours, &mut n);
+                        tracer.shade_tile(
+                            &tile_rays,
+                            &tile_hits[..k],
+                            colours,
+                            &mut n,
+                            &mut scratch,
+                        );
                         for (i, c) in colours.iter().enumerate() {
                             pixels[i / cols * w + x0 + i % cols] = *c;
                         }

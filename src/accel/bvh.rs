@@ -197,14 +197,17 @@ impl Bvh {
         let mut bound = cull_bound(t_max);
         let r = RayLanes::new(ray);
         let mut c = Closest::new(t_max);
-        // Nodes still to visit with their entry distances, farthest at the bottom of each
-        // node's run.
-        let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
+        // Nodes still to visit as `entry distance's bits << 32 | reference`, each node's run
+        // sorted farthest at the bottom. An entry distance is `+0.0` or positive (the slab test
+        // starts at 0 and only raises it), so its bits order as the distances do.
+        let mut stack = [MaybeUninit::<u64>::uninit(); STACK];
         let mut sp = 0;
         let mut cur = self.root;
         loop {
             if cur & LEAF != 0 {
                 let (blocks, ids) = self.leaf(cur);
+                // The scene indices are read only for a hit, after the kernel: ask for them now.
+                prefetch(ids.as_ptr());
                 blocks_closest::<K>(blocks, ids, ray, &r, &mut c);
                 if let Some(h) = c.best {
                     bound = cull_bound(h.t);
@@ -222,16 +225,16 @@ impl Bvh {
                     }
                     // Two or more: push them sorted by entry distance, nearest on top, and
                     // take the nearest.
+                    let key = |l: usize| u64::from(t[l].to_bits()) << 32 | u64::from(node.child[l]);
                     let base = sp;
-                    stack[sp] = MaybeUninit::new((node.child[l], t[l]));
+                    stack[sp] = MaybeUninit::new(key(l));
                     sp += 1;
                     while mask != 0 {
-                        let l = mask.trailing_zeros() as usize;
+                        let entry = key(mask.trailing_zeros() as usize);
                         mask &= mask - 1;
-                        let entry = (node.child[l], t[l]);
                         let mut i = sp;
                         // SAFETY: entries `base..sp` were written above.
-                        while i > base && unsafe { stack[i - 1].assume_init() }.1 < entry.1 {
+                        while i > base && unsafe { stack[i - 1].assume_init() } < entry {
                             stack[i] = stack[i - 1];
                             i -= 1;
                         }
@@ -240,7 +243,7 @@ impl Bvh {
                     }
                     sp -= 1;
                     // SAFETY: written above.
-                    cur = unsafe { stack[sp].assume_init() }.0;
+                    cur = unsafe { stack[sp].assume_init() } as u32;
                     continue;
                 }
             }
@@ -251,9 +254,9 @@ impl Bvh {
                 }
                 sp -= 1;
                 // SAFETY: every entry below `sp` has been written.
-                let (n, t_enter) = unsafe { stack[sp].assume_init() };
-                if t_enter <= bound {
-                    cur = n;
+                let e = unsafe { stack[sp].assume_init() };
+                if f32::from_bits((e >> 32) as u32) <= bound {
+                    cur = e as u32;
                     break;
                 }
             }
@@ -299,6 +302,20 @@ impl Bvh {
             cur = unsafe { stack[sp].assume_init() };
         }
     }
+}
+
+/// Asks for the cache line at `p` (a hint: it reads nothing, cannot fault and changes no
+/// result).
+#[inline(always)]
+fn prefetch<T>(p: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch only hints the cache; it is defined for any address.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>(p.cast::<i8>());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
 }
 
 #[cfg(target_arch = "x86_64")]

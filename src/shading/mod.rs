@@ -353,15 +353,14 @@ impl<'a> Tracer<'a> {
         hits: &[Option<Hit>],
         out: &mut [Vec3],
         n: &mut RayCounts,
+        scratch: &mut TileScratch,
     ) {
         debug_assert!(self.shades_tiles());
-        const MAX: usize = crate::accel::TILE_RAYS;
-        assert!(rays.len() <= MAX && hits.len() == rays.len() && out.len() == rays.len());
-        // Per pixel being shaded here: the hit point, its error, the normal facing the ray.
-        let mut at = [(Vec3::ZERO, Vec3::ZERO, Vec3::ZERO); MAX];
-        let mut sum = [Vec3::ZERO; MAX];
-        let mut here = [0u8; MAX];
-        let mut k = 0;
+        assert!(hits.len() == rays.len() && out.len() == rays.len());
+        // Per pixel being shaded here: the hit point, its error, the normal facing the ray,
+        // and where it goes in `out`.
+        let TileScratch { at, sum, terms } = scratch;
+        at.clear();
         for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
             let Some(hit) = hit else {
                 out[i] = Vec3::ZERO;
@@ -385,16 +384,17 @@ impl<'a> Tracer<'a> {
             } else {
                 tri.normal
             };
-            at[k] = (p, err, normal);
-            here[k] = i as u8;
-            k += 1;
+            at.push((p, err, normal, i));
         }
-        let mut terms = [None; MAX];
+        sum.clear();
+        sum.resize(at.len(), Vec3::ZERO);
         for light in self.lights {
-            for (t, &(p, err, normal)) in terms.iter_mut().zip(&at[..k]) {
-                *t = self.light_term(light, p, err, normal);
-            }
-            for (s, t) in sum.iter_mut().zip(&terms[..k]) {
+            terms.clear();
+            terms.extend(
+                at.iter()
+                    .map(|&(p, err, normal, _)| self.light_term(light, p, err, normal)),
+            );
+            for (s, t) in sum.iter_mut().zip(terms.iter()) {
                 let Some((term, shadow)) = t else { continue };
                 if let Some(ray) = shadow {
                     n.shadow += 1;
@@ -405,10 +405,9 @@ impl<'a> Tracer<'a> {
                 *s += *term;
             }
         }
-        for j in 0..k {
-            let i = here[j] as usize;
+        for (&(.., i), &sum) in at.iter().zip(sum.iter()) {
             out[i] = if self.settings.mode == Mode::Irradiance {
-                sum[j]
+                sum
             } else {
                 let tri = &self.scene.triangles()[hits[i].expect("a hit").triangle as usize];
                 let material = &self.scene.materials()[tri.material as usize];
@@ -416,11 +415,20 @@ impl<'a> Tracer<'a> {
                     Indirect::Constant(k) => Vec3::splat(k),
                     _ => Vec3::ZERO,
                 };
-                material.colour * (sum[j] + indirect)
+                material.colour * (sum + indirect)
             };
             debug_assert!(out[i].is_finite(), "non-finite colour {}", out[i]);
         }
     }
+}
+
+/// Scratch space [`Tracer::shade_tile`] reuses from tile to tile: start with
+/// `TileScratch::default()`.
+#[derive(Clone, Debug, Default)]
+pub struct TileScratch {
+    at: Vec<(Vec3, Vec3, Vec3, usize)>,
+    sum: Vec<Vec3>,
+    terms: Vec<Option<(Vec3, Option<Ray>)>>,
 }
 
 /// A cosine-weighted direction on the hemisphere around `n` (unit length).

@@ -7,8 +7,9 @@
 //! the terminal has read meanwhile. So the bytes taken between the first "would block" of a
 //! frame and the frame's end, over that time, are the drain rate. From the rate:
 //! - the queue is modelled (bytes written, less rate × time), and the writer waits until it is
-//!   down to [`LOW_WATER`] of link time before it takes the next frame, so a frame reaches the
-//!   screen soon after it is encoded rather than behind a full queue;
+//!   down to [`LOW_WATER`] of link time (or a little more than a frame's encoding time) before
+//!   it takes the next frame, so a frame reaches the screen soon after it is encoded rather than
+//!   behind a full queue;
 //! - each frame gets a byte budget of [`FRAME_TIME`] of link time.
 //!
 //! An unmeasured link (writes never blocked) counts as fast: no budget, exact frames. A rate
@@ -24,6 +25,9 @@ pub const FRAME_TIME: Duration = Duration::from_millis(65);
 /// The writer takes the next frame once the queue is down to this much link time: enough to
 /// keep the link busy while the next frame is encoded, little enough that it shows soon.
 pub const LOW_WATER: Duration = Duration::from_millis(25);
+/// The queue is kept at least this many times the last frame's encoding time (see
+/// [`Link::wait`]).
+const ENCODE_MARGIN: f64 = 1.5;
 /// A drain-rate sample needs at least this much time with the queue full (shorter ones are
 /// dominated by scheduling noise and by the burst a link lets through after a pause).
 const MIN_SAMPLE: Duration = Duration::from_millis(30);
@@ -137,11 +141,15 @@ impl Link {
         }
     }
 
-    /// How long after `now` the queue is down to [`LOW_WATER`] of link time.
-    pub fn wait(&self, now: Instant) -> Duration {
+    /// How long after `now` the queue is down to [`LOW_WATER`] of link time, or to the time
+    /// the next frame takes to encode (`encode`, measured on the last one) with
+    /// [`ENCODE_MARGIN`] if that is longer: so the link does not run dry while the next frame
+    /// is encoded, even on a loaded machine.
+    pub fn wait(&self, now: Instant, encode: Duration) -> Duration {
         match self.rate {
             Some(r) => {
-                let excess = self.queued(now) - r * LOW_WATER.as_secs_f64();
+                let low = LOW_WATER.max(encode.mul_f64(ENCODE_MARGIN));
+                let excess = self.queued(now) - r * low.as_secs_f64();
                 Duration::from_secs_f64((excess / r).max(0.0))
             }
             None => Duration::ZERO,
@@ -183,7 +191,7 @@ mod tests {
         l.wrote(100_000, t);
         l.frame_done(0, None, t + MS);
         assert_eq!(
-            (l.budget(), l.wait(t + MS), describe(l.rate())),
+            (l.budget(), l.wait(t + MS, MS), describe(l.rate())),
             (None, Duration::ZERO, "fast".into())
         );
     }
@@ -201,9 +209,12 @@ mod tests {
         assert_eq!(describe(l.rate()), "1.0Mbit/s");
         assert_eq!(l.budget(), Some(8125));
         // The queue is full (20 kB = 160 ms of link): the writer waits it down to 25 ms.
-        let wait = l.wait(t + 1000 * MS);
+        let wait = l.wait(t + 1000 * MS, MS);
         assert!((wait.as_secs_f64() - 0.135).abs() < 1e-3, "{wait:?}");
-        assert_eq!(l.wait(t + 1200 * MS), Duration::ZERO);
+        assert_eq!(l.wait(t + 1200 * MS, MS), Duration::ZERO);
+        // A frame that took 40 ms to encode: the writer comes back at 60 ms of queue.
+        let slow = l.wait(t + 1000 * MS, 40 * MS);
+        assert!((slow.as_secs_f64() - 0.100).abs() < 1e-3, "{slow:?}");
         assert_eq!(l.queued(t + 1200 * MS), 0.0);
     }
 

@@ -68,10 +68,13 @@ enum Input {
     Written(io::Result<LinkView>),
 }
 
-/// A frame for the writer, tagged with the terminal's epoch it was encoded for.
+/// A frame for the writer, tagged with the terminal's epoch it was encoded for, and how long
+/// it took to encode (the writer comes back for the next one that long before the link would
+/// run dry).
 struct Job {
     epoch: u64,
     bytes: Vec<u8>,
+    encode: Duration,
 }
 
 /// Holds the terminal in raw mode on the alternate screen; restores it when dropped.
@@ -191,7 +194,7 @@ fn spawn_writer_thread(tx: Sender<Input>) -> Sender<Job> {
             let report = write_frame(&job, &mut link).map(|()| {
                 // Let the queue drain to its low-water mark before taking the next frame, so
                 // the next frame shows soon after it is encoded.
-                let wait = link.wait(Instant::now()).min(MAX_PACING_WAIT);
+                let wait = link.wait(Instant::now(), job.encode).min(MAX_PACING_WAIT);
                 std::thread::sleep(wait);
                 LinkView {
                     budget: link.budget(),
@@ -321,6 +324,7 @@ fn event_loop(mut app: App, rx: &Receiver<Input>, writer: &Sender<Job>) -> Resul
                 let job = Job {
                     epoch: tty::epoch(),
                     bytes,
+                    encode: last_draw.elapsed(),
                 };
                 writer
                     .send(job)
