@@ -7,7 +7,9 @@
 //! roulette test) is the first two dimensions of the Sobol sequence, a (0,2)-sequence, with the
 //! point's index shuffled and each coordinate Owen-scrambled by a hash seeded with (pixel,
 //! dimension). So every pair is stratified on its own, pairs are decorrelated from each other,
-//! and each number is uniform, as the estimator needs to stay unbiased. Samples of a pixel are
+//! and each number is uniform, as the estimator needs to stay unbiased. The first two bounces'
+//! directions are one 4D point instead (Sobol dimensions 0-3 of one shuffled index), so that
+//! the light of two-bounce paths, which depends on both at once, is stratified too. Samples of a pixel are
 //! points `frame·samples + sample` of one sequence: a frame of N samples continues where the
 //! previous frame stopped, so progressive passes (the app's) and one batch draw the same
 //! points, and any prefix of a power-of-two length is a well-spread net.
@@ -161,12 +163,26 @@ impl Sobol {
     /// reversed bits), the first two Sobol coordinates, each Owen-scrambled; every seed from
     /// (pixel, dimension). Worked in reversed bits, where the Sobol coordinates are the index
     /// itself and [`sobol_1_reversed`], and a scramble is one [`upward_hash`].
+    /// [`FOUR_D_SECOND`] takes Sobol dimensions 2 and 3 at the previous pair's shuffled index
+    /// instead (with scrambles of its own).
     #[inline]
     fn pair(&self, dimension: u32) -> [f32; 2] {
-        let (shuffle, sx) = self.seeds(dimension);
-        let i = upward_hash(self.index_reversed, shuffle).reverse_bits();
-        let x = upward_hash(i, sx);
-        let y = upward_hash(sobol_1_reversed(i), second_seed(sx));
+        let (x, y) = if dimension == FOUR_D_SECOND {
+            let (shuffle, _) = self.seeds(FOUR_D_SECOND - 1);
+            let (_, sx) = self.seeds(dimension);
+            let i = upward_hash(self.index_reversed, shuffle).reverse_bits();
+            (
+                upward_hash(sobol_reversed(&SOBOL_2, i), sx),
+                upward_hash(sobol_reversed(&SOBOL_3, i), second_seed(sx)),
+            )
+        } else {
+            let (shuffle, sx) = self.seeds(dimension);
+            let i = upward_hash(self.index_reversed, shuffle).reverse_bits();
+            (
+                upward_hash(i, sx),
+                upward_hash(sobol_1_reversed(i), second_seed(sx)),
+            )
+        };
         // Both turned back at once: one 64-bit reversal costs what one of 32 bits does.
         let xy = ((u64::from(x) << 32) | u64::from(y)).reverse_bits();
         [unit(xy as u32), unit((xy >> 32) as u32)]
@@ -177,6 +193,9 @@ impl SampleSource for Sobol {
     /// The first coordinate of the next pair (the second is not computed).
     #[inline]
     fn next_1d(&mut self) -> f32 {
+        if self.dimension == FOUR_D_SECOND {
+            return self.next_2d()[0];
+        }
         let (shuffle, sx) = self.seeds(self.dimension);
         self.dimension += 1;
         let i = upward_hash(self.index_reversed, shuffle).reverse_bits();
@@ -189,6 +208,78 @@ impl SampleSource for Sobol {
         self.dimension += 1;
         p
     }
+}
+
+/// The pair drawn second by a path (the second bounce's direction) is Sobol dimensions 2 and 3
+/// of the first bounce's shuffled index: the two bounces form one 4D point.
+const FOUR_D_SECOND: u32 = PIXEL_DIMENSION + 2;
+
+/// A Sobol dimension's 32 direction numbers (as 32-bit fractions) from its primitive polynomial
+/// of degree `s` (inner coefficients `a`, highest first) and initial numbers `m` (Bratley and
+/// Fox's recurrence: m_k = 2a₁m_{k−1} ⊕ … ⊕ 2^{s−1}a_{s−1}m_{k−s+1} ⊕ 2^s m_{k−s} ⊕ m_{k−s}).
+const fn direction_numbers(s: usize, a: u32, m: [u32; 3]) -> [u32; 32] {
+    let mut mk = [0u32; 32];
+    let mut k = 0;
+    while k < 32 {
+        if k < s {
+            mk[k] = m[k];
+        } else {
+            let mut v = mk[k - s] ^ (mk[k - s] << s);
+            let mut j = 1;
+            while j < s {
+                if (a >> (s - 1 - j)) & 1 != 0 {
+                    v ^= mk[k - j] << j;
+                }
+                j += 1;
+            }
+            mk[k] = v;
+        }
+        k += 1;
+    }
+    let mut out = [0u32; 32];
+    let mut k = 0;
+    while k < 32 {
+        out[k] = mk[k] << (31 - k);
+        k += 1;
+    }
+    out
+}
+
+/// Byte tables of a dimension's generator: entry `[b][v]` is the XOR of the direction numbers
+/// of byte `b`'s set bits when it holds `v`, its bits reversed (as the scrambles take it).
+const fn byte_tables(v: [u32; 32]) -> [[u32; 256]; 4] {
+    let mut t = [[0u32; 256]; 4];
+    let mut b = 0;
+    while b < 4 {
+        let mut x = 0;
+        while x < 256 {
+            let mut acc = 0;
+            let mut bit = 0;
+            while bit < 8 {
+                if (x >> bit) & 1 != 0 {
+                    acc ^= v[b * 8 + bit];
+                }
+                bit += 1;
+            }
+            t[b][x] = acc.reverse_bits();
+            x += 1;
+        }
+        b += 1;
+    }
+    t
+}
+
+/// Sobol dimension 2: x² + x + 1, m = 1, 3 (Joe and Kuo's table).
+static SOBOL_2: [[u32; 256]; 4] = byte_tables(direction_numbers(2, 1, [1, 3, 0]));
+/// Sobol dimension 3: x³ + x + 1, m = 1, 3, 1 (Joe and Kuo's table).
+static SOBOL_3: [[u32; 256]; 4] = byte_tables(direction_numbers(3, 1, [1, 3, 1]));
+
+/// A Sobol dimension at `index` (a 32-bit fraction, bits reversed) from its byte tables: four
+/// lookups.
+#[inline]
+fn sobol_reversed(t: &[[u32; 256]; 4], i: u32) -> u32 {
+    let b = i.to_le_bytes();
+    t[0][b[0] as usize] ^ t[1][b[1] as usize] ^ t[2][b[2] as usize] ^ t[3][b[3] as usize]
 }
 
 /// Keeps the Sobol sampler's pixel keys apart from [`Rng`]'s (any odd constant: the first

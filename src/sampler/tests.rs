@@ -8,33 +8,101 @@ fn points(pixel: u64, dimension: u32, n: u32) -> Vec<[f32; 2]> {
         .collect()
 }
 
+/// The smallest t for which `points` (2^m of them) form a (t, m, 2)-net: every box of size
+/// 2^-a × 2^-(m-t-a) holds exactly 2^t points.
+fn t_value(points: &[[f32; 2]], m: u32) -> u32 {
+    (0..=m)
+        .find(|&t| {
+            (0..=m - t).all(|a| {
+                let (bx, by) = (1u32 << a, 1u32 << (m - t - a));
+                let mut count = vec![0u32; (bx * by) as usize];
+                for p in points {
+                    let (cx, cy) = ((p[0] * bx as f32) as u32, (p[1] * by as f32) as u32);
+                    count[(cy * bx + cx) as usize] += 1;
+                }
+                count.iter().all(|&c| c == 1 << t)
+            })
+        })
+        .unwrap_or(m)
+}
+
 /// The first 2^m points of every pair, in every pixel tried, form a (0, m, 2)-net: each of
 /// the 2^m boxes of size 2^-a × 2^-(m-a) holds exactly one point. That is what makes 64 or 256
 /// samples cover a pixel's pairs evenly; a broken scramble (one that let a digit depend on
-/// lower digits) or a wrong direction number fails it.
+/// lower digits) or a wrong direction number fails it. The second bounce's pair (Sobol
+/// dimensions 2 and 3 of the first bounce's point) is a (2, m, 2)-net, the best those two
+/// dimensions give, and each of its coordinates alone is stratified.
 #[test]
 fn every_power_of_two_prefix_is_a_net() {
     for pixel in [0, 1, 77, 12_345, u64::MAX] {
         for dimension in 0..6 {
             for m in 0..=10u32 {
-                let n = 1u32 << m;
-                let pts = points(pixel, dimension, n);
-                for a in 0..=m {
-                    let (bx, by) = (1u32 << a, 1u32 << (m - a));
-                    let mut seen = vec![false; n as usize];
-                    for p in &pts {
-                        let cx = (p[0] * bx as f32) as u32;
-                        let cy = (p[1] * by as f32) as u32;
-                        let cell = (cy * bx + cx) as usize;
-                        assert!(
-                            !seen[cell],
-                            "pixel {pixel}, pair {dimension}, {n} points: box {a} shared"
-                        );
-                        seen[cell] = true;
-                    }
+                let pts = points(pixel, dimension, 1 << m);
+                let t = t_value(&pts, m);
+                let most = if dimension == FOUR_D_SECOND { 2 } else { 0 };
+                assert!(
+                    t <= most,
+                    "pixel {pixel}, pair {dimension}, 2^{m} points: t = {t}"
+                );
+                for k in 0..2 {
+                    let mut cells: Vec<u32> = pts
+                        .iter()
+                        .map(|p| (p[k] * pts.len() as f32) as u32)
+                        .collect();
+                    cells.sort_unstable();
+                    cells.dedup();
+                    assert_eq!(cells.len(), pts.len(), "pair {dimension} coordinate {k}");
                 }
             }
         }
+    }
+}
+
+/// The first two bounces' pairs are one 4D point, so they are stratified jointly: the first
+/// coordinates of the two pairs form a (1, m, 2)-net (Sobol dimensions 0 and 2), where two
+/// independently shuffled pairs would leave boxes empty.
+#[test]
+fn the_first_two_bounces_are_one_four_dimensional_point() {
+    for pixel in [0, 5, 999] {
+        for m in 2..=10u32 {
+            let first = points(pixel, FOUR_D_SECOND - 1, 1 << m);
+            let second = points(pixel, FOUR_D_SECOND, 1 << m);
+            let joint: Vec<[f32; 2]> = first
+                .iter()
+                .zip(&second)
+                .map(|(a, b)| [a[0], b[0]])
+                .collect();
+            assert!(t_value(&joint, m) <= 1, "pixel {pixel}, 2^{m} points");
+        }
+    }
+    // The control: the pixel offset and the first bounce are shuffled apart.
+    let apart: Vec<[f32; 2]> = points(3, PIXEL_DIMENSION, 256)
+        .iter()
+        .zip(&points(3, FOUR_D_SECOND - 1, 256))
+        .map(|(a, b)| [a[0], b[0]])
+        .collect();
+    assert!(t_value(&apart, 8) > 1);
+}
+
+/// Sobol dimensions 2 and 3 from their direction numbers are the Sobol sequence's: its first
+/// eight points (index i in Gray-code order g = i ⊕ i/2, as tables list them).
+#[test]
+fn dimensions_two_and_three_are_sobols() {
+    let listed = [
+        [0.0, 0.0],
+        [0.5, 0.5],
+        [0.25, 0.25],
+        [0.75, 0.75],
+        [0.625, 0.875],
+        [0.125, 0.375],
+        [0.875, 0.625],
+        [0.375, 0.125],
+    ];
+    for (n, want) in listed.iter().enumerate() {
+        let g = (n ^ (n >> 1)) as u32;
+        let got = [sobol_reversed(&SOBOL_2, g), sobol_reversed(&SOBOL_3, g)]
+            .map(|x| f64::from(x.reverse_bits()) / 4_294_967_296.0);
+        assert_eq!(got, *want, "point {n}");
     }
 }
 
