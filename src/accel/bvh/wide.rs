@@ -56,7 +56,8 @@ pub(super) struct Collapsed {
 /// blocks. A node takes its two children, then keeps replacing its interior child of largest
 /// surface area (the first such on a tie) by that child's two children, up to [`WIDTH`]; the
 /// children keep the binary tree's left-to-right order. Deterministic: it depends only on the
-/// binary tree.
+/// binary tree. (Laying out the top levels' subtrees in parallel and joining them was tried:
+/// copying the joined blocks cost what the second thread saved.)
 pub(super) fn collapse(pairs: &[NodePair], order: &[u32], triangles: &[Triangle]) -> Collapsed {
     let n_blocks: usize = pairs
         .iter()
@@ -69,12 +70,22 @@ pub(super) fn collapse(pairs: &[NodePair], order: &[u32], triangles: &[Triangle]
         ids: Vec::with_capacity(n_blocks * LANES),
         depth: 0,
     };
-    if pairs.is_empty() {
-        return c;
+    if !pairs.is_empty() {
+        let t = Tree {
+            pairs,
+            order,
+            triangles,
+        };
+        c.root = t.visit(0, &mut c, 0);
     }
-    let node = |i: usize| pairs[i / 2].0[i % 2];
-    c.root = visit(0, &node, order, triangles, &mut c, 0);
     c
+}
+
+/// The binary tree being collapsed.
+struct Tree<'a> {
+    pairs: &'a [NodePair],
+    order: &'a [u32],
+    triangles: &'a [Triangle],
 }
 
 fn area(n: &Node) -> f64 {
@@ -82,69 +93,87 @@ fn area(n: &Node) -> f64 {
     2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
 }
 
-/// Lays out binary node `i`'s subtree at wide level `level`; returns its reference.
-fn visit(
-    i: usize,
-    node: &impl Fn(usize) -> Node,
-    order: &[u32],
-    triangles: &[Triangle],
-    c: &mut Collapsed,
-    level: u32,
-) -> u32 {
-    let n = node(i);
-    if n.is_leaf() {
-        let first = c.blocks.len();
-        let leaf = &order[n.offset as usize..(n.offset + n.count) as usize];
-        c.blocks
-            .extend(Tri4::pack(leaf.iter().map(|&t| triangles[t as usize].v)));
-        c.ids.extend_from_slice(leaf);
-        c.ids.resize(c.blocks.len() * LANES, u32::MAX);
-        let count = c.blocks.len() - first;
-        assert!(
-            first < 1 << 28 && count <= LEAF_BLOCKS_MAX,
-            "a BVH holds at most 2²⁸ blocks of four triangles"
-        );
-        return LEAF | (first as u32) << 3 | (count as u32 - 1);
+impl Tree<'_> {
+    fn node(&self, i: usize) -> Node {
+        self.pairs[i / 2].0[i % 2]
     }
-    c.depth = c.depth.max(level + 1);
-    let mut kids = [0usize; WIDTH];
-    kids[..2].copy_from_slice(&[n.offset as usize, n.offset as usize + 1]);
-    let mut len = 2;
-    while len < WIDTH {
-        let mut widest: Option<(usize, f64)> = None;
-        for (k, &kid) in kids[..len].iter().enumerate() {
-            let kn = node(kid);
-            if !kn.is_leaf() && widest.is_none_or(|(_, a)| area(&kn) > a) {
-                widest = Some((k, area(&kn)));
+
+    /// The binary nodes that become interior node `n`'s children, in order.
+    fn open(&self, n: &Node) -> ([usize; WIDTH], usize) {
+        let mut kids = [0usize; WIDTH];
+        kids[..2].copy_from_slice(&[n.offset as usize, n.offset as usize + 1]);
+        let mut len = 2;
+        while len < WIDTH {
+            let mut widest: Option<(usize, f64)> = None;
+            for (k, &kid) in kids[..len].iter().enumerate() {
+                let kn = self.node(kid);
+                if !kn.is_leaf() && widest.is_none_or(|(_, a)| area(&kn) > a) {
+                    widest = Some((k, area(&kn)));
+                }
             }
+            let Some((k, _)) = widest else { break };
+            let first = self.node(kids[k]).offset as usize;
+            kids.copy_within(k + 1..len, k + 2);
+            kids[k] = first;
+            kids[k + 1] = first + 1;
+            len += 1;
         }
-        let Some((k, _)) = widest else { break };
-        let first = node(kids[k]).offset as usize;
-        kids.copy_within(k + 1..len, k + 2);
-        kids[k] = first;
-        kids[k + 1] = first + 1;
-        len += 1;
+        (kids, len)
     }
-    let at = c.nodes.len();
-    c.nodes.push(Wide {
-        boxes: Box8::default(),
-        child: [0; WIDTH],
-        valid: (1 << len) - 1,
-    });
-    for (lane, &kid) in kids[..len].iter().enumerate() {
-        let kn = node(kid);
-        let r = visit(kid, node, order, triangles, c, level + 1);
-        let w = &mut c.nodes[at];
-        w.boxes.set(
-            lane,
-            &Aabb {
-                min: kn.min,
-                max: kn.max,
-            },
-        );
-        w.child[lane] = r;
+
+    /// A new node over children `kids` (their references to be filled in).
+    fn wide(&self, kids: &[usize]) -> Wide {
+        let mut w = Wide {
+            boxes: Box8::default(),
+            child: [0; WIDTH],
+            valid: (1 << kids.len()) - 1,
+        };
+        for (lane, &kid) in kids.iter().enumerate() {
+            let kn = self.node(kid);
+            w.boxes.set(
+                lane,
+                &Aabb {
+                    min: kn.min,
+                    max: kn.max,
+                },
+            );
+        }
+        w
     }
-    at as u32
+
+    /// Lays out binary node `i`'s subtree at wide level `level` at the end of `c`; returns
+    /// its reference.
+    fn visit(&self, i: usize, c: &mut Collapsed, level: u32) -> u32 {
+        let n = self.node(i);
+        if n.is_leaf() {
+            let first = c.blocks.len();
+            let leaf = &self.order[n.offset as usize..(n.offset + n.count) as usize];
+            for chunk in leaf.chunks(LANES) {
+                let mut v = [[glam::Vec3::ZERO; 3]; LANES];
+                for (v, &t) in v.iter_mut().zip(chunk) {
+                    *v = self.triangles[t as usize].v;
+                }
+                c.blocks.push(Tri4::new(&v[..chunk.len()]));
+            }
+            c.ids.extend_from_slice(leaf);
+            c.ids.resize(c.blocks.len() * LANES, u32::MAX);
+            let count = c.blocks.len() - first;
+            assert!(
+                first < 1 << 28 && count <= LEAF_BLOCKS_MAX,
+                "a BVH holds at most 2²⁸ blocks of four triangles"
+            );
+            return LEAF | (first as u32) << 3 | (count as u32 - 1);
+        }
+        c.depth = c.depth.max(level + 1);
+        let (kids, len) = self.open(&n);
+        let at = c.nodes.len();
+        c.nodes.push(self.wide(&kids[..len]));
+        for (lane, &kid) in kids[..len].iter().enumerate() {
+            let r = self.visit(kid, c, level + 1);
+            c.nodes[at].child[lane] = r;
+        }
+        at as u32
+    }
 }
 
 /// The binary tree's figures, kept for [`super::Bvh::nodes`] and friends.
