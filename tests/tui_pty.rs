@@ -505,16 +505,25 @@ fn a_signal_ends_the_app_in_time_and_restores_even_when_the_link_is_stalled() {
         s.wait_for_status(&["indirect"]);
         // The terminal stops reading (a stalled SSH connection) while keys keep coming.
         s.paused.store(true, Ordering::SeqCst);
-        s.send(&[b'd'; 200]);
         let deadline = Instant::now() + TIMEOUT;
-        // The app writes a new frame into the pty until it is full (a full 300x100 frame is
-        // far larger than the pty holds).
-        while unread(s.master.as_deref().unwrap()) < 4000 {
+        // The app writes new frames into the pty until it holds 4000 unread bytes. The light
+        // goes back and forth, 20 presses at a time, so every batch changes the frame (the
+        // reader may have taken one last chunk as it paused, and a light far out of the box
+        // changes nothing).
+        let full = |s: &Session| unread(s.master.as_deref().unwrap()) >= 4000;
+        for batch in 0.. {
+            if full(&s) {
+                break;
+            }
             assert!(
                 Instant::now() < deadline,
                 "SIG{name}: the app wrote no new frame"
             );
-            std::thread::sleep(EXIT_POLL);
+            s.send(&[if batch % 2 == 0 { b'd' } else { b'a' }; 20]);
+            let next_batch = Instant::now() + Duration::from_millis(300);
+            while !full(&s) && Instant::now() < next_batch {
+                std::thread::sleep(EXIT_POLL);
+            }
         }
         let pid = s.child.process_id().expect("pid");
         let killed = std::process::Command::new("kill")
