@@ -7,12 +7,14 @@
 //! roulette test) is the first two dimensions of the Sobol sequence, a (0,2)-sequence, with the
 //! point's index shuffled and each coordinate Owen-scrambled by a hash seeded with (pixel,
 //! dimension). So every pair is stratified on its own, pairs are decorrelated from each other,
-//! and each number is uniform, as the estimator needs to stay unbiased. The first two bounces'
-//! directions are one 4D point instead (Sobol dimensions 0-3 of one shuffled index), so that
-//! the light of two-bounce paths, which depends on both at once, is stratified too. Samples of a pixel are
-//! points `frame·samples + sample` of one sequence: a frame of N samples continues where the
-//! previous frame stopped, so progressive passes (the app's) and one batch draw the same
-//! points, and any prefix of a power-of-two length is a well-spread net.
+//! and each number is uniform, as the estimator needs to stay unbiased. The first two pairs a
+//! path draws (its first two bounces' directions) are one 4D point instead (Sobol dimensions
+//! 0-3 of one shuffled index), so that the light of two-bounce paths, which depends on both at
+//! once, is stratified too.
+//!
+//! Samples of a pixel are points `frame·samples + sample` of one sequence: a frame of N samples
+//! continues where the previous frame stopped, so progressive passes (the app's) and one batch
+//! draw the same points, and any prefix of a power-of-two length is a well-spread net.
 
 use crate::rng::{Rng, mix};
 

@@ -78,9 +78,11 @@ pub struct AccelStats {
     pub kind: AccelKind,
     /// Triangles it holds.
     pub triangles: usize,
-    /// Boxes: BVH nodes, or the flat list's objects.
+    /// Boxes: the nodes of the BVH's binary SAH tree (traversal reads it collapsed into
+    /// wide nodes of up to eight children, `Bvh::wide_nodes`), or the flat list's objects.
     pub nodes: usize,
-    /// Levels of boxes above the triangles (1 for the flat list, 0 when empty).
+    /// Levels of boxes above the triangles: the binary tree's (1 for the flat list, 0 when
+    /// empty).
     pub depth: u32,
     /// Wall-clock build time.
     pub build: Duration,
