@@ -17,10 +17,6 @@ pub const LOWER_HALF: char = '▄';
 /// The full block: its foreground paints both pixels.
 pub const FULL_BLOCK: char = '█';
 
-/// Text cells (the status line, the help) are sent row by row, the next the cheapest (cursor
-/// move, SGR, character) of the next this many to send.
-const ORDER_WINDOW: usize = 16;
-
 /// How far a cell on screen may be from the frame's: a cell is sent if any channel of either
 /// of its pixels differs by more than `tolerance` levels (0: exact), or if it differs in any
 /// way that is not a colour level (a character, a palette colour).
@@ -145,7 +141,16 @@ pub fn encode_diff_within(
         max_error: 0,
     };
     let cols = next.cols;
-    exact::send_block_cells(screen, next, limits, &mut w, out, start);
+    // A row with text in it (the status line, the help) is sent whole, left to right, whatever
+    // the budget: a half-sent line of text (its spaces are block cells) would read as garble.
+    let text_rows: Vec<bool> = (0..next.rows)
+        .map(|r| {
+            next.cells[r * cols..(r + 1) * cols]
+                .iter()
+                .any(|c| pixels(c).is_none())
+        })
+        .collect();
+    exact::send_block_cells(screen, next, &text_rows, limits, &mut w, out, start);
     'rows: for k in 0..next.rows {
         let r = (limits.first_row + k) % next.rows.max(1);
         let row = r * cols..(r + 1) * cols;
@@ -159,13 +164,14 @@ pub fn encode_diff_within(
             distance(&have[c], &want[c]) > limits.tolerance as u16
                 || (tail && have[c + 1] != want[c + 1])
         };
-        // Block cells were sent above (or the budget stopped them): what is left is text.
-        let send = |_: Pen, c: usize| want[c];
+        // Block cells were sent above (or the budget stopped them): what is left is rows of
+        // text, sent left to right (so that a frame shown half-received, by a terminal without
+        // synchronized output, shows the new text up to a column and the old after it).
         let mut todo: Vec<usize> = (0..cols).filter(|&c| dirty(have, c)).collect();
         while !todo.is_empty() {
-            // Over the budget, only text is still sent (the status line, the help): image
-            // cells wait for the next frame, which begins with this row.
-            if out.len() - start >= limits.max_bytes {
+            // Over the budget, only rows of text are still sent: image cells wait for the next
+            // frame, which begins with this row.
+            if !text_rows[r] && out.len() - start >= limits.max_bytes {
                 if outcome.complete {
                     outcome = DiffOutcome {
                         complete: false,
@@ -173,19 +179,12 @@ pub fn encode_diff_within(
                         max_error: UNLIKE,
                     };
                 }
-                todo.retain(|&c| pixels(&want[c]).is_none());
-                if todo.is_empty() {
-                    continue 'rows;
-                }
+                continue 'rows;
             }
-            // Of the next few cells of the row to send, the cheapest to reach and draw.
-            let pick = (0..todo.len().min(ORDER_WINDOW))
-                .min_by_key(|&k| w.move_len(r, todo[k]) + w.draw_cost(&send(w.pen, todo[k])))
-                .unwrap_or(0);
-            let c = todo.remove(pick);
+            let c = todo.remove(0);
             w.move_to(out, r, c);
-            let cell = send(w.pen, c);
-            w.draw(out, &cell, todo.first().map(|&n| send(w.pen, n)).as_ref());
+            let cell = want[c];
+            w.draw(out, &cell, todo.first().map(|&n| want[n]).as_ref());
             have[c] = cell;
             let wide = c + 1 < cols && want[c + 1].ch == WIDE_TAIL;
             if wide {

@@ -96,11 +96,12 @@ impl Pending {
 
 /// Sends the block cells of `next` that `screen` shows further than the tolerance from it
 /// (0: not exactly), [`quantize`]d to the tolerance, cheapest first (see the module's note),
-/// updating `screen`, until `out` holds `max_bytes` since `start`. Text cells are left to the
-/// caller (they are few, and their colours are not a pixel's).
+/// updating `screen`, until `out` holds `max_bytes` since `start`. Rows with text in them
+/// (`text_rows`) are left to the caller, which sends them whole.
 pub(super) fn send_block_cells(
     screen: &mut CellGrid,
     next: &CellGrid,
+    text_rows: &[bool],
     limits: DiffLimits,
     w: &mut Writer,
     out: &mut Vec<u8>,
@@ -130,7 +131,7 @@ pub(super) fn send_block_cells(
         })
         .collect();
     let mut pending = Pending::default();
-    for r in 0..rows {
+    for r in (0..rows).filter(|&r| !text_rows[r]) {
         for c in 0..cols {
             let i = r * cols + c;
             if let Some(px) = pixels(&send[i])

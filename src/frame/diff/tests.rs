@@ -350,3 +350,36 @@ fn within_a_tolerance_a_gradient_shares_a_few_colours_each_within_it() {
     assert_eq!(sgrs(0), 40);
     assert!(sgrs(8) <= 4, "{}", sgrs(8));
 }
+
+#[test]
+fn over_the_budget_a_row_with_text_is_still_sent_whole_spaces_and_all() {
+    let (a, b, c) = (
+        Colour::Rgb(10, 20, 30),
+        Colour::Rgb(200, 100, 50),
+        Colour::Rgb(90, 90, 90),
+    );
+    let text = |ch: char| Cell {
+        ch,
+        fg: Some(b),
+        bg: Some(c),
+    };
+    // Two image rows, then a status line whose spaces (with a background) are block cells.
+    let mut prev = vec![block(a, a); 20];
+    prev.extend("xxxxxxxxxx".chars().map(text));
+    let mut next = vec![block(b, c); 20];
+    next.extend("ab  cd  ef".chars().map(text));
+    let (prev, next) = (grid(prev, 10), grid(next, 10));
+    let mut shown = Some(prev.clone());
+    let mut out = Vec::new();
+    let limits = DiffLimits {
+        max_bytes: 1,
+        ..DiffLimits::EXACT
+    };
+    let outcome = encode_diff_within(&mut shown, &next, 0, limits, &mut out);
+    let mut terminal = prev.clone();
+    apply(&mut terminal, &out);
+    assert!(!outcome.complete);
+    assert_eq!(looks(&terminal)[20..], looks(&next)[20..]);
+    assert_eq!(looks(&terminal), looks(shown.as_ref().unwrap()));
+    assert_ne!(looks(&terminal)[..20], looks(&next)[..20]);
+}
