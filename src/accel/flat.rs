@@ -129,6 +129,28 @@ impl Flat {
         }
     }
 
+    /// [`Flat::occluded`] for each of `rays`, into `out` (as many), on path `isa` (must be
+    /// available): the path picked once for them all.
+    pub fn occluded_each(&self, isa: Isa, rays: &[Ray], t_max: f32, out: &mut [bool]) {
+        debug_assert!(isa.available(), "{} is not available", isa.name());
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the caller passes an available path.
+            Isa::Avx2 => unsafe { occluded_each_avx2(self, rays, t_max, out) },
+            #[cfg(target_arch = "x86_64")]
+            Isa::Sse2 => {
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = occluded::<super::tri4::Sse2>(self, r, t_max);
+                }
+            }
+            _ => {
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = occluded::<Portable>(self, r, t_max);
+                }
+            }
+        }
+    }
+
     /// Any hit on path `isa` (must be available).
     pub fn occluded(&self, isa: Isa, ray: &Ray, t_max: f32) -> bool {
         debug_assert!(isa.available(), "{} is not available", isa.name());
@@ -183,6 +205,14 @@ unsafe fn tile_avx2(
     tile::intersect_tile::<super::tri4::Avx2>(f, rays, t_max, hits, cache, |r| {
         closest::<super::tri4::Avx2>(f, r, t_max)
     });
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn occluded_each_avx2(f: &Flat, rays: &[Ray], t_max: f32, out: &mut [bool]) {
+    for (o, r) in out.iter_mut().zip(rays) {
+        *o = occluded::<super::tri4::Avx2>(f, r, t_max);
+    }
 }
 
 #[cfg(target_arch = "x86_64")]

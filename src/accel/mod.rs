@@ -206,6 +206,18 @@ impl Accel {
         }
     }
 
+    /// [`Accel::occluded`] for each of `rays`, into `out` (as many).
+    pub fn occluded_each(&self, rays: &[Ray], t_max: f32, out: &mut [bool]) {
+        match &self.structure {
+            Structure::Flat(flat) => flat.occluded_each(self.isa, rays, t_max, out),
+            Structure::Bvh(_) => {
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = self.occluded(r, t_max);
+                }
+            }
+        }
+    }
+
     /// Whether any triangle has a hit with `t < t_max` (stops at the first).
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {

@@ -341,6 +341,12 @@ impl Scene {
         self.accel.intersect_tile(rays, t_max, hits, cache)
     }
 
+    /// [`Scene::occluded`] for each of `rays`, into `out` (as many).
+    #[inline]
+    pub fn occluded_each(&self, rays: &[Ray], t_max: f32, out: &mut [bool]) {
+        self.accel.occluded_each(rays, t_max, out)
+    }
+
     /// Whether anything blocks `ray` before `t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {

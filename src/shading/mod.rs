@@ -360,7 +360,13 @@ impl<'a> Tracer<'a> {
         assert!(hits.len() == rays.len() && out.len() == rays.len());
         // Per pixel being shaded here: the hit point, its error, the normal facing the ray,
         // and where it goes in `out`.
-        let TileScratch { at, sum, terms } = scratch;
+        let TileScratch {
+            at,
+            sum,
+            terms,
+            rays: shadows,
+            blocked,
+        } = scratch;
         at.clear();
         for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
             let Some(hit) = hit else {
@@ -392,13 +398,19 @@ impl<'a> Tracer<'a> {
         for light in self.lights {
             terms.clear();
             self.light_terms(light, at, terms);
+            // The tile's shadow rays, traced together.
+            shadows.clear();
+            shadows.extend(terms.iter().filter_map(|t| t.and_then(|(_, s)| s)));
+            blocked.clear();
+            blocked.resize(shadows.len(), false);
+            self.scene
+                .occluded_each(shadows, 1.0 - SHADOW_EPSILON, blocked);
+            n.shadow += shadows.len() as u64;
+            let mut blocked = blocked.iter();
             for (s, t) in sum.iter_mut().zip(terms.iter()) {
                 let Some((term, shadow)) = t else { continue };
-                if let Some(ray) = shadow {
-                    n.shadow += 1;
-                    if self.scene.occluded(ray, 1.0 - SHADOW_EPSILON) {
-                        continue;
-                    }
+                if shadow.is_some() && *blocked.next().expect("one answer per shadow ray") {
+                    continue;
                 }
                 *s += *term;
             }
@@ -427,6 +439,8 @@ pub struct TileScratch {
     at: Vec<(Vec3, Vec3, Vec3, usize)>,
     sum: Vec<Vec3>,
     terms: Vec<Option<(Vec3, Option<Ray>)>>,
+    rays: Vec<Ray>,
+    blocked: Vec<bool>,
 }
 
 /// A cosine-weighted direction on the hemisphere around `n` (unit length).
