@@ -12,7 +12,7 @@ use crate::geometry::{Aabb, Triangle};
 pub const WIDTH: usize = BOX_LANES;
 
 /// A child reference with this bit set is a leaf: its first block is the reference's bits
-/// 3..31 and its block count one more than bits 0..2. Without it, a node index.
+/// 3..30 and its block count one more than bits 0..2. Without it, a node index.
 pub(super) const LEAF: u32 = 1 << 31;
 
 /// Most blocks a leaf reference can name: bits 0..2.
