@@ -13,6 +13,7 @@ use crate::scene::{Indirect, Material, PointLight, Scene};
 
 mod split;
 mod stage;
+mod tile;
 
 pub use split::{GuideHit, SplitSample};
 pub use stage::{Mode, RayCounts, Settings, Stage};
@@ -390,10 +391,7 @@ impl<'a> Tracer<'a> {
         sum.resize(at.len(), Vec3::ZERO);
         for light in self.lights {
             terms.clear();
-            terms.extend(
-                at.iter()
-                    .map(|&(p, err, normal, _)| self.light_term(light, p, err, normal)),
-            );
+            self.light_terms(light, at, terms);
             for (s, t) in sum.iter_mut().zip(terms.iter()) {
                 let Some((term, shadow)) = t else { continue };
                 if let Some(ray) = shadow {
