@@ -12,7 +12,17 @@ const MAX_PENDING: usize = 32;
 #[derive(Debug, Default)]
 pub struct KeyParser {
     pending: Vec<u8>,
+    /// Replies to [`ACK_QUERY`] parsed and not yet taken.
+    acks: usize,
 }
+
+/// The query appended after a frame to learn when the terminal has processed it: primary
+/// device attributes (DA1, `CSI c`). Every terminal since the VT100 answers it (xterm, tmux,
+/// screen, VTE, kitty, alacritty, the Linux console), in order with the output before it, with
+/// `CSI ? ... c`, which no key sends. The cursor position report (`CSI 6 n`) is answered by
+/// fewer terminals, and its reply `CSI row ; col R` is also what xterm sends for F3 with a
+/// modifier (`CSI 1 ; 2 R`), so a reply could be taken for a key or a key for a reply.
+pub const ACK_QUERY: &[u8] = b"\x1b[c";
 
 impl KeyParser {
     /// The key events in `bytes` (after what an earlier call left incomplete). A lone ESC at
@@ -26,6 +36,10 @@ impl KeyParser {
         let mut i = 0;
         while i < buf.len() {
             match parse_one(&buf[i..]) {
+                Parsed::Reply(used) => {
+                    self.acks += 1;
+                    i += used;
+                }
                 Parsed::Key(used, key) => {
                     keys.extend(key);
                     i += used;
@@ -39,6 +53,12 @@ impl KeyParser {
             }
         }
         keys
+    }
+
+    /// How many replies to [`ACK_QUERY`] the bytes fed so far held (since the last call):
+    /// they are consumed silently, never as keys.
+    pub fn take_acks(&mut self) -> usize {
+        std::mem::take(&mut self.acks)
     }
 
     /// Whether a lone ESC waits for what follows it: the reader then waits at most
@@ -69,6 +89,8 @@ pub const ESC_DELAY: std::time::Duration = std::time::Duration::from_millis(50);
 enum Parsed {
     /// Bytes used and the key they make, if any.
     Key(usize, Option<KeyEvent>),
+    /// Bytes used by the terminal's reply to [`ACK_QUERY`].
+    Reply(usize),
     /// The buffer ends inside a sequence.
     Incomplete,
 }
@@ -90,6 +112,7 @@ fn parse_one(b: &[u8]) -> Parsed {
             },
             // ESC then a key: Alt+key.
             Some(_) => match parse_one(&b[1..]) {
+                Parsed::Reply(n) => Parsed::Key(n + 1, None),
                 Parsed::Key(n, k) => Parsed::Key(
                     n + 1,
                     k.map(|mut k| {
@@ -145,6 +168,10 @@ fn parse_csi(b: &[u8]) -> Parsed {
     let Some(&f) = b.get(j) else {
         return Parsed::Incomplete;
     };
+    // The reply to the device-attributes query: `CSI ? 1 ; 2 c` and the like.
+    if f == b'c' && b.get(2) == Some(&b'?') {
+        return Parsed::Reply(j + 1);
+    }
     let params = std::str::from_utf8(&b[2..j]).unwrap_or("");
     // xterm's modifier parameter "1;m": m − 1 is a bit set of Shift 1, Alt 2, Ctrl 4.
     let m: u8 = params
@@ -255,6 +282,49 @@ mod tests {
                 (KeyCode::Char('?'), KeyModifiers::NONE),
             ]
         );
+    }
+
+    #[test]
+    fn device_attribute_replies_are_counted_never_keys_whole_split_or_mixed() {
+        let mut p = KeyParser::default();
+        let n = KeyModifiers::NONE;
+        // Whole, as xterm and tmux send it.
+        assert_eq!(codes(&mut p, b"\x1b[?1;2c"), vec![]);
+        assert_eq!(p.take_acks(), 1);
+        assert_eq!(p.take_acks(), 0);
+        // Mixed with keys on both sides, two replies in one read.
+        assert_eq!(
+            codes(&mut p, b"w\x1b[?62;22c\x1b[Aw\x1b[?6c"),
+            vec![
+                (KeyCode::Char('w'), n),
+                (KeyCode::Up, n),
+                (KeyCode::Char('w'), n)
+            ]
+        );
+        assert_eq!(p.take_acks(), 2);
+        // Split across reads at every point: no key, one reply, no Esc.
+        let reply = b"\x1b[?1;2c";
+        for cut in 1..reply.len() {
+            assert_eq!(codes(&mut p, &reply[..cut]), vec![], "cut {cut}");
+            assert_eq!(p.take_acks(), 0);
+            assert!(p.timeout().is_empty() || cut == 1);
+            if cut == 1 {
+                // A lone ESC for longer than the delay is the Esc key (as before); a reply
+                // arrives in one write, so this split only happens within the delay.
+                p = KeyParser::default();
+                continue;
+            }
+            assert_eq!(codes(&mut p, &reply[cut..]), vec![], "cut {cut}");
+            assert_eq!(p.take_acks(), 1, "cut {cut}");
+        }
+        // Split right after the ESC, the rest within the delay.
+        assert_eq!(codes(&mut p, b"\x1b"), vec![]);
+        assert!(p.waiting_on_escape());
+        assert_eq!(codes(&mut p, b"[?1;2cq"), vec![(KeyCode::Char('q'), n)]);
+        assert_eq!(p.take_acks(), 1);
+        // Other CSI ... c sequences (no `?`) are not replies.
+        assert_eq!(codes(&mut p, b"\x1b[0c"), vec![]);
+        assert_eq!(p.take_acks(), 0);
     }
 
     #[test]

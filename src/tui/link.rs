@@ -109,15 +109,7 @@ impl Link {
     pub fn frame_done(&mut self, drained: usize, full_for: Option<Duration>, now: Instant) {
         match full_for {
             Some(t) if t >= MIN_SAMPLE && drained > 0 => {
-                let sample = drained as f64 / t.as_secs_f64();
-                if t >= LONG_SAMPLE {
-                    self.ceiling = self.ceiling.max(sample);
-                }
-                self.rate = Some(match self.rate {
-                    Some(r) if sample < r => r + WEIGHT_DOWN * (sample - r),
-                    Some(r) => r + WEIGHT_UP * (sample - r),
-                    None => sample,
-                });
+                self.sample(drained, t);
                 self.queued = self.capacity;
                 self.at = now;
             }
@@ -141,6 +133,31 @@ impl Link {
         }
     }
 
+    /// `bytes` went through the link in `t`: a rate sample, taken if `t` is long enough.
+    fn sample(&mut self, bytes: usize, t: Duration) {
+        if t < MIN_SAMPLE || bytes == 0 {
+            return;
+        }
+        let sample = bytes as f64 / t.as_secs_f64();
+        if t >= LONG_SAMPLE {
+            self.ceiling = self.ceiling.max(sample);
+        }
+        self.rate = Some(match self.rate {
+            Some(r) if sample < r => r + WEIGHT_DOWN * (sample - r),
+            Some(r) => r + WEIGHT_UP * (sample - r),
+            None => sample,
+        });
+    }
+
+    /// The terminal acknowledged at `now` everything written before a query: `bytes` took
+    /// `t` of link time to get there (a rate sample, if long enough), and `unacknowledged`
+    /// bytes written since are all that can still be queued.
+    pub fn acknowledged(&mut self, bytes: usize, t: Duration, unacknowledged: usize, now: Instant) {
+        self.sample(bytes, t);
+        self.queued = unacknowledged as f64;
+        self.at = now;
+    }
+
     /// How long after `now` the queue is down to [`LOW_WATER`] of link time, or to the time
     /// the next frame takes to encode (`encode`, measured on the last one) with
     /// [`ENCODE_MARGIN`] if that is longer: so the link does not run dry while the next frame
@@ -160,6 +177,165 @@ impl Link {
     pub fn budget(&self) -> Option<usize> {
         self.rate
             .map(|r| ((r * FRAME_TIME.as_secs_f64()) as usize).max(MIN_BUDGET))
+    }
+}
+
+/// How long the first query may go unanswered before the terminal counts as one that does not
+/// answer: then no more queries, and the link is measured by the drain rate alone.
+pub const ACK_PROBE_TIMEOUT: Duration = Duration::from_secs(1);
+/// Once the terminal answers, how long the writer waits for the previous frame's
+/// acknowledgement before it gives up on them (and falls back to the drain rate). Longer than
+/// a whole unbudgeted first frame takes over a slow link.
+pub const ACK_WAIT: Duration = Duration::from_secs(2);
+
+/// Whether the terminal acknowledges frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum AckState {
+    /// No query sent yet.
+    Unasked,
+    /// The first query went out at this time; no reply yet.
+    Probing(Instant),
+    /// The terminal answers: every frame ends with a query.
+    On,
+    /// It did not answer (or stopped): no more queries.
+    Off,
+}
+
+/// Pacing by the terminal's acknowledgement, for links whose buffers the drain rate cannot see
+/// (over SSH, the pty drains into sshd's and TCP's buffers at once, however slow the network).
+/// The writer ends each frame with a query the terminal answers only once it has processed
+/// everything before it ([`ACK_QUERY`](super::input::ACK_QUERY)); the time from writing to the
+/// answer gives the end-to-end latency (the least such time: the first query goes out alone)
+/// and throughput (the bytes since the previous query, over the time from when they could
+/// first arrive to the answer), fed into [`Link`]. The writer keeps at most one acknowledged
+/// frame outstanding while the app encodes the next ([`Acks::waiting`]). Pure, like [`Link`].
+#[derive(Clone, Debug)]
+pub struct Acks {
+    state: AckState,
+    /// Queries in flight, oldest first: when the bytes before each began to be written, and how
+    /// many there were since the query before.
+    sent: std::collections::VecDeque<(Instant, usize)>,
+    /// Bytes written since the last query, and when the first of them was.
+    unqueried: Option<(Instant, usize)>,
+    /// When the last acknowledgement arrived.
+    last: Option<Instant>,
+    /// The least time from a write to its acknowledgement: the link's latency.
+    latency: Option<Duration>,
+}
+
+impl Acks {
+    /// Nothing asked yet.
+    pub fn new() -> Acks {
+        Acks {
+            state: AckState::Unasked,
+            sent: Default::default(),
+            unqueried: None,
+            last: None,
+            latency: None,
+        }
+    }
+
+    /// What to write around a frame that begins at `now`: (a query before it, a query after
+    /// it). The very first frame is preceded by one (an answer to it measures latency alone);
+    /// once the terminal has answered, every frame is followed by one; while the first is
+    /// unanswered, and after [`ACK_PROBE_TIMEOUT`] without an answer, none.
+    pub fn queries(&mut self, now: Instant) -> (bool, bool) {
+        self.expire(now);
+        match self.state {
+            AckState::Unasked => {
+                self.state = AckState::Probing(now);
+                (true, false)
+            }
+            AckState::On => (false, true),
+            AckState::Probing(_) | AckState::Off => (false, false),
+        }
+    }
+
+    /// A frame of `bytes` (queries included) was written, beginning at `start`; `before` and
+    /// `after` say where its queries were (as [`Acks::queries`] said).
+    pub fn wrote(&mut self, start: Instant, bytes: usize, before: bool, after: bool) {
+        if before {
+            self.query(start);
+        }
+        let (at, n) = self.unqueried.unwrap_or((start, 0));
+        self.unqueried = Some((at, n + bytes));
+        if after {
+            self.query(start);
+        }
+    }
+
+    fn query(&mut self, now: Instant) {
+        let (at, n) = self.unqueried.take().unwrap_or((now, 0));
+        self.sent.push_back((at, n));
+    }
+
+    /// An acknowledgement arrived at `now`: the state and `link` learn from it.
+    pub fn acked(&mut self, now: Instant, link: &mut Link) {
+        let Some((at, bytes)) = self.sent.pop_front() else {
+            return; // a reply to a query given up on
+        };
+        if matches!(self.state, AckState::Probing(_)) {
+            self.state = AckState::On;
+        }
+        if self.state != AckState::On {
+            return;
+        }
+        let took = now.saturating_duration_since(at);
+        let latency = self.latency.map_or(took, |l| l.min(took));
+        self.latency = Some(latency);
+        // The bytes could not arrive before the link's latency, nor be taken before the
+        // previous acknowledgement (the link was busy with what came before).
+        let mut begin = at + latency;
+        if let Some(last) = self.last {
+            begin = begin.max(last);
+        }
+        self.last = Some(now);
+        let unacknowledged =
+            self.sent.iter().map(|s| s.1).sum::<usize>() + self.unqueried.map_or(0, |u| u.1);
+        link.acknowledged(
+            bytes,
+            now.saturating_duration_since(begin),
+            unacknowledged,
+            now,
+        );
+    }
+
+    /// Whether the writer should wait for an acknowledgement before taking the next frame:
+    /// the terminal answers and more than one frame is unacknowledged.
+    pub fn waiting(&self) -> bool {
+        self.state == AckState::On && self.sent.len() > 1
+    }
+
+    /// No acknowledgement came within [`ACK_WAIT`]: the terminal stopped answering; stop
+    /// asking and fall back to the drain rate.
+    pub fn give_up(&mut self) {
+        self.state = AckState::Off;
+        self.sent.clear();
+    }
+
+    /// Whether the terminal answers (the status line's estimate is then end to end).
+    pub fn on(&self) -> bool {
+        self.state == AckState::On
+    }
+
+    /// The link's latency as measured by the acknowledgements, once answered.
+    #[cfg(test)]
+    pub fn latency(&self) -> Option<Duration> {
+        self.latency
+    }
+
+    fn expire(&mut self, now: Instant) {
+        if let AckState::Probing(t) = self.state
+            && now.saturating_duration_since(t) >= ACK_PROBE_TIMEOUT
+        {
+            self.give_up();
+        }
+    }
+}
+
+impl Default for Acks {
+    fn default() -> Acks {
+        Acks::new()
     }
 }
 
@@ -216,6 +392,66 @@ mod tests {
         let slow = l.wait(t + 1000 * MS, 40 * MS);
         assert!((slow.as_secs_f64() - 0.100).abs() < 1e-3, "{slow:?}");
         assert_eq!(l.queued(t + 1200 * MS), 0.0);
+    }
+
+    #[test]
+    fn slow_acknowledgements_shrink_the_budget_and_keep_one_frame_in_flight() {
+        let t = Instant::now();
+        let mut l = Link::new(t);
+        let mut a = Acks::new();
+        // The first frame is preceded by a query; the reply comes after 10 ms of latency.
+        assert_eq!(a.queries(t), (true, false));
+        a.wrote(t, 20_003, true, false);
+        assert!(!a.waiting(), "no waiting before the terminal has answered");
+        a.acked(t + 10 * MS, &mut l);
+        assert!(a.on());
+        assert_eq!(a.latency(), Some(10 * MS));
+        // Frames now end with a query; writes never block (sshd takes everything), so the
+        // drain rate sees nothing (the writer leaves `frame_done` out while acknowledged).
+        let mut now = t + 10 * MS;
+        for i in 0..6 {
+            assert_eq!(a.queries(now), (false, true));
+            a.wrote(now, 20_000, false, true);
+            l.wrote(20_000, now);
+            if i == 0 {
+                // The first two frames are acknowledged together.
+                assert!(!a.waiting());
+                continue;
+            }
+            assert!(a.waiting(), "two frames in flight: wait for the older");
+            // The older one is acknowledged when the link has carried it.
+            now += 200 * MS;
+            a.acked(now, &mut l);
+            assert!(!a.waiting());
+        }
+        let rate = l.rate().expect("measured by acknowledgements");
+        assert!((80_000.0..=120_000.0).contains(&rate), "{rate}");
+        assert_eq!(describe(l.rate()), "850kbit/s");
+        let budget = l.budget().unwrap();
+        assert!((5_000..=8_000).contains(&budget), "{budget}");
+        // The queue model knows a frame is still in flight.
+        assert!(l.queued(now) >= 20_000.0);
+    }
+
+    #[test]
+    fn a_terminal_that_never_answers_is_asked_once_and_changes_nothing() {
+        let t = Instant::now();
+        let mut l = Link::new(t);
+        let mut a = Acks::new();
+        assert_eq!(a.queries(t), (true, false));
+        a.wrote(t, 50_003, true, false);
+        // Within the first second, frames go out without queries or waiting.
+        for ms in [100, 500, 999] {
+            assert_eq!(a.queries(t + ms * MS), (false, false));
+            a.wrote(t + ms * MS, 50_000, false, false);
+            assert!(!a.waiting());
+        }
+        // After it, never again; a late reply changes nothing.
+        assert_eq!(a.queries(t + 1000 * MS), (false, false));
+        a.acked(t + 1500 * MS, &mut l);
+        assert_eq!(a.queries(t + 2000 * MS), (false, false));
+        assert!(!a.on() && !a.waiting());
+        assert_eq!((l.rate(), l.budget()), (None, None));
     }
 
     #[test]

@@ -14,6 +14,7 @@
 
 use std::io::{self, IsTerminal};
 use std::os::fd::{AsRawFd, RawFd};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::time::{Duration, Instant};
 
@@ -24,9 +25,9 @@ use signal_hook::consts::{SIGHUP, SIGINT, SIGQUIT, SIGSTOP, SIGTERM, SIGWINCH};
 use signal_hook::iterator::Signals;
 
 use super::app::{App, Message, update};
-use super::input::{ESC_DELAY, KeyParser};
+use super::input::{ACK_QUERY, ESC_DELAY, KeyParser};
 use super::keys::message_for;
-use super::link::Link;
+use super::link::{ACK_WAIT, Acks, Link};
 use super::tty;
 use super::view::{GI_MAX_PASSES, LinkView, Screen};
 
@@ -42,6 +43,14 @@ const WRITER_POLL: Duration = Duration::from_millis(100);
 /// The writer never waits longer than this for the queue to drain before taking the next
 /// frame, whatever the link model says (a wrong estimate must not stall the app).
 const MAX_PACING_WAIT: Duration = Duration::from_millis(250);
+
+/// On quitting, how long the app waits for the terminal to answer the queries still
+/// outstanding (an answer arriving after the restore would be echoed on the shell's line).
+const QUIT_ACK_WAIT: Duration = Duration::from_millis(300);
+/// Queries written and not answered yet (the writer adds, the reader takes away).
+static UNANSWERED: AtomicUsize = AtomicUsize::new(0);
+/// The terminal answers queries (set by the writer).
+static ACKS_ON: AtomicBool = AtomicBool::new(false);
 
 /// How the app ended; the binary turns it into an exit status.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -125,17 +134,30 @@ pub fn run(scene: Scene, color: ColorMode) -> Result<Outcome> {
         .context("cannot install signal handlers")?;
     let guard = Guard::enter(input)?;
     spawn_signal_thread(signals, tx.clone());
-    spawn_reader_thread(input, tx.clone());
-    let writer = spawn_writer_thread(tx);
+    let (ack_tx, ack_rx) = mpsc::channel();
+    spawn_reader_thread(input, tx.clone(), ack_tx);
+    let writer = spawn_writer_thread(tx, ack_rx);
     let size = tty::size().context("cannot read the terminal size")?;
     let outcome = event_loop(App::new(scene, color, size), &rx, &writer);
+    if matches!(outcome, Ok(Outcome::Quit)) {
+        // Let the answers to the last queries come in while raw mode still hides them, so
+        // they do not land on the shell's command line.
+        let deadline = Instant::now() + QUIT_ACK_WAIT;
+        while ACKS_ON.load(Ordering::SeqCst)
+            && UNANSWERED.load(Ordering::SeqCst) > 0
+            && Instant::now() < deadline
+        {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
     drop(guard);
     outcome
 }
 
 /// Reads keys until end-of-file or an error. A lone ESC waits up to [`ESC_DELAY`] for the rest
-/// of a sequence a slow link may have split.
-fn spawn_reader_thread(fd: RawFd, tx: Sender<Input>) {
+/// of a sequence a slow link may have split. The terminal's replies to the writer's queries go
+/// to the writer (`acks`, with the time they arrived), never to the loop as keys.
+fn spawn_reader_thread(fd: RawFd, tx: Sender<Input>, acks: Sender<Instant>) {
     std::thread::spawn(move || {
         let mut parser = KeyParser::default();
         let mut buf = [0u8; 1024];
@@ -155,6 +177,14 @@ fn spawn_reader_thread(fd: RawFd, tx: Sender<Input>) {
             } else {
                 parser.timeout()
             };
+            let now = Instant::now();
+            for _ in 0..parser.take_acks() {
+                // The writer may be gone (the app is ending): the keys still go to the loop.
+                let _ = acks.send(now);
+                let _ = UNANSWERED.fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
+                    Some(n.saturating_sub(1))
+                });
+            }
             for k in keys {
                 if tx.send(Input::Key(k)).is_err() {
                     return;
@@ -185,17 +215,41 @@ fn spawn_signal_thread(mut signals: Signals, tx: Sender<Input>) {
 
 /// The writer: takes frames one at a time and writes each through the non-blocking descriptor,
 /// waiting for room as the terminal drains. A frame from before a suspend, or after a restore,
-/// is dropped. Reports each frame back to the loop.
-fn spawn_writer_thread(tx: Sender<Input>) -> Sender<Job> {
+/// is dropped. Reports each frame back to the loop. Frames are paced by the terminal's
+/// acknowledgements where it answers (see [`Acks`]), else by the drain rate alone.
+fn spawn_writer_thread(tx: Sender<Input>, acks_rx: Receiver<Instant>) -> Sender<Job> {
     let (jobs, rx) = mpsc::channel::<Job>();
     std::thread::spawn(move || {
         let mut link = Link::new(Instant::now());
-        for job in rx {
-            let report = write_frame(&job, &mut link).map(|()| {
+        let mut acks = Acks::new();
+        for mut job in rx {
+            while let Ok(at) = acks_rx.try_recv() {
+                acks.acked(at, &mut link);
+            }
+            let start = Instant::now();
+            let (before, after) = acks.queries(start);
+            if before {
+                job.bytes.splice(0..0, ACK_QUERY.iter().copied());
+            }
+            if after {
+                job.bytes.extend_from_slice(ACK_QUERY);
+            }
+            let report = write_frame(&job, &mut link, acks.on()).map(|()| {
+                acks.wrote(start, job.bytes.len(), before, after);
+                UNANSWERED.fetch_add(usize::from(before) + usize::from(after), Ordering::SeqCst);
                 // Let the queue drain to its low-water mark before taking the next frame, so
                 // the next frame shows soon after it is encoded.
                 let wait = link.wait(Instant::now(), job.encode).min(MAX_PACING_WAIT);
                 std::thread::sleep(wait);
+                // And keep at most one frame unacknowledged by a terminal that answers.
+                let deadline = Instant::now() + ACK_WAIT;
+                while acks.waiting() {
+                    match acks_rx.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+                        Ok(at) => acks.acked(at, &mut link),
+                        Err(_) => acks.give_up(),
+                    }
+                }
+                ACKS_ON.store(acks.on(), Ordering::SeqCst);
                 LinkView {
                     budget: link.budget(),
                     rate: link.rate(),
@@ -209,8 +263,10 @@ fn spawn_writer_thread(tx: Sender<Input>) -> Sender<Job> {
     jobs
 }
 
-/// Writes one frame, measuring the link as it goes (see [`Link`]).
-fn write_frame(job: &Job, link: &mut Link) -> io::Result<()> {
+/// Writes one frame, measuring the link as it goes (see [`Link`]). With `acknowledged` (the
+/// terminal answers queries) a frame that never blocked says nothing of the link: the
+/// acknowledgements measure it.
+fn write_frame(job: &Job, link: &mut Link, acknowledged: bool) -> io::Result<()> {
     let fd = tty::writer_fd();
     let mut rest = &job.bytes[..];
     // When the queue was first found full, and the bytes taken since.
@@ -237,7 +293,9 @@ fn write_frame(job: &Job, link: &mut Link) -> io::Result<()> {
         }
     }
     let now = Instant::now();
-    link.frame_done(drained, full_since.map(|t| now - t), now);
+    if full_since.is_some() || !acknowledged {
+        link.frame_done(drained, full_since.map(|t| now - t), now);
+    }
     Ok(())
 }
 
