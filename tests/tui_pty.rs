@@ -643,3 +643,46 @@ fn over_a_slow_link_a_move_is_sent_approximately_then_settles_exact() {
         "the move was never shown approximately: the link was not measured"
     );
 }
+
+#[test]
+fn behind_a_deep_buffer_a_terminal_that_answers_paces_the_frames() {
+    // As over SSH: the pty drains at once into a deep buffer, the link behind it carries
+    // 60 kB/s, and the far end answers each device-attributes query once it has shown what came
+    // before. Writes never block, so only the answers can show the link is slow: a light move
+    // is then sent approximately (a budget, so a measured rate: writes never block here).
+    let (cols, rows) = (100u16, 30u16);
+    let mut link = slow_link::SlowLink::start_behind_buffer(
+        env!("CARGO_BIN_EXE_raytty"),
+        &["--color", "truecolor"],
+        cols,
+        rows,
+        60_000.0,
+    );
+    let start = expected(cols, rows, 0.0, 0.0);
+    assert!(
+        link.wait_for(TIMEOUT, |s| slow_link::max_error(s, &start) == 0),
+        "the first frame never showed"
+    );
+    link.send(b"wwwww");
+    let scene = cornell_box();
+    let camera = scene.camera();
+    let mut lights = scene.lights().to_vec();
+    for _ in 0..5 {
+        lights[0].position += camera.to_world(Vec3::new(0.0, 0.0, 1.0) * (0.1 * 1.0));
+    }
+    let moved = slow_link::app_image(&camera, &lights, cols, rows);
+    let mut seen_approximate = false;
+    let settled = link.wait_for(TIMEOUT, |s| {
+        let status = s.contents_between(rows - 1, 0, rows - 1, cols);
+        seen_approximate |= status.contains("approximate");
+        slow_link::max_error(s, &moved) == 0 && !status.contains("approximate")
+    });
+    assert!(settled, "the screen never settled on the exact frame");
+    assert!(
+        seen_approximate,
+        "the move was never shown approximately: the answers did not measure the link"
+    );
+    // The answers were consumed as answers: nothing typed reached the app as keys (a reply
+    // read as keys would be Esc, `[`, `?`... and Esc quits).
+    assert!(link.child.try_wait().expect("the child's status").is_none());
+}

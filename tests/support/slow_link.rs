@@ -37,13 +37,37 @@ pub struct Far {
 pub struct SlowLink {
     pub child: Box<dyn Child + Send + Sync>,
     master: Box<dyn MasterPty + Send>,
-    writer: Box<dyn Write + Send>,
+    writer: Arc<Mutex<Box<dyn Write + Send>>>,
     pub far: Arc<Mutex<Far>>,
 }
 
 impl SlowLink {
     /// Starts `program` with `args` in a `cols × rows` pty drained at `rate` bytes per second.
     pub fn start(program: &str, args: &[&str], cols: u16, rows: u16, rate: f64) -> SlowLink {
+        SlowLink::start_with(program, args, cols, rows, rate, false)
+    }
+
+    /// Like [`SlowLink::start`], but as over SSH: the pty is drained at once into a deep buffer
+    /// (sshd's and TCP's), which the link then carries at `rate`; and the far end answers the
+    /// device-attributes query (`ESC [ c`) once it has processed it, as xterm and tmux do.
+    pub fn start_behind_buffer(
+        program: &str,
+        args: &[&str],
+        cols: u16,
+        rows: u16,
+        rate: f64,
+    ) -> SlowLink {
+        SlowLink::start_with(program, args, cols, rows, rate, true)
+    }
+
+    fn start_with(
+        program: &str,
+        args: &[&str],
+        cols: u16,
+        rows: u16,
+        rate: f64,
+        deep: bool,
+    ) -> SlowLink {
         let pair = native_pty_system()
             .openpty(PtySize {
                 rows,
@@ -59,7 +83,26 @@ impl SlowLink {
         let child = pair.slave.spawn_command(cmd).expect("spawn the program");
         drop(pair.slave);
         let mut reader = pair.master.try_clone_reader().expect("pty reader");
-        let writer = pair.master.take_writer().expect("pty writer");
+        let writer = Arc::new(Mutex::new(pair.master.take_writer().expect("pty writer")));
+        let answers = writer.clone();
+        // The deep buffer: everything the program wrote that the link has not carried yet.
+        let buffer: Arc<Mutex<(std::collections::VecDeque<u8>, bool)>> = Default::default();
+        if deep {
+            let buffer = buffer.clone();
+            let mut reader = pair.master.try_clone_reader().expect("pty reader");
+            std::thread::spawn(move || {
+                let mut buf = vec![0u8; READ_MAX];
+                loop {
+                    let n = reader.read(&mut buf).unwrap_or(0);
+                    let mut b = buffer.lock().expect("the buffer");
+                    if n == 0 {
+                        b.1 = true;
+                        return;
+                    }
+                    b.0.extend(&buf[..n]);
+                }
+            });
+        }
         let far = Arc::new(Mutex::new(Far {
             screen: vt100::Parser::new(
                 std::num::NonZeroU16::new(rows).expect("rows"),
@@ -75,6 +118,8 @@ impl SlowLink {
             let start = Instant::now();
             let mut read = 0.0f64;
             let mut buf = vec![0u8; READ_MAX];
+            // The end of the bytes delivered so far, for a query split between deliveries.
+            let mut tail: Vec<u8> = Vec::new();
             loop {
                 // A token bucket: what the link has carried by now, less what was read, at most
                 // a burst.
@@ -86,9 +131,26 @@ impl SlowLink {
                     continue;
                 }
                 let want = (allowed as usize).min(READ_MAX);
-                let n = match reader.read(&mut buf[..want]) {
-                    Ok(0) | Err(_) => break,
-                    Ok(n) => n,
+                let n = if deep {
+                    let mut b = buffer.lock().expect("the buffer");
+                    if b.0.is_empty() {
+                        if b.1 {
+                            break;
+                        }
+                        drop(b);
+                        std::thread::sleep(TICK);
+                        continue;
+                    }
+                    let n = want.min(b.0.len());
+                    for (d, s) in buf.iter_mut().zip(b.0.drain(..n)) {
+                        *d = s;
+                    }
+                    n
+                } else {
+                    match reader.read(&mut buf[..want]) {
+                        Ok(0) | Err(_) => break,
+                        Ok(n) => n,
+                    }
                 };
                 read += n as f64;
                 let now = Instant::now();
@@ -96,6 +158,18 @@ impl SlowLink {
                 far.screen.process(&buf[..n]);
                 far.bytes += n;
                 far.last_read = Some(now);
+                drop(far);
+                if deep {
+                    // Answer each query once the bytes before it are shown.
+                    tail.extend_from_slice(&buf[..n]);
+                    let queries = tail.windows(3).filter(|w| w == b"\x1b[c").count();
+                    for _ in 0..queries {
+                        let mut w = answers.lock().expect("the pty writer");
+                        let _ = w.write_all(b"\x1b[?62;22c").and_then(|()| w.flush());
+                    }
+                    let keep = tail.len().min(2);
+                    tail.drain(..tail.len() - keep);
+                }
             }
             shared.lock().expect("the far end").closed = true;
         });
@@ -109,8 +183,9 @@ impl SlowLink {
 
     /// Types `bytes` (the link's upstream is not throttled: keys are small).
     pub fn send(&mut self, bytes: &[u8]) {
-        self.writer.write_all(bytes).expect("write to the pty");
-        self.writer.flush().expect("flush the pty");
+        let mut w = self.writer.lock().expect("the pty writer");
+        w.write_all(bytes).expect("write to the pty");
+        w.flush().expect("flush the pty");
     }
 
     /// Waits until `cond` holds for the far end's screen, at most `limit`; whether it did.
