@@ -115,6 +115,7 @@ pub(super) fn run_render(
             File::options()
                 .write(true)
                 .create(true)
+                .truncate(false)
                 .open(path)
                 .with_context(|| format!("cannot create {}", path.display()))?,
         ),
