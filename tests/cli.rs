@@ -62,6 +62,28 @@ fn images_are_written_to_files() {
     let out = raytty(&["render", "--size", "20x6", "-o", sized.to_str().unwrap()]);
     assert!(out.status.success());
     assert!(std::fs::read(&sized).unwrap().starts_with(b"PF\n20 12\n"));
+    // An existing file is overwritten to exactly the new frame, whether it was longer or shorter.
+    for (name, old) in [
+        ("long.pfm", vec![7u8; 100_000]),
+        ("short.pfm", vec![7u8; 10]),
+        ("long.txt", vec![7u8; 100_000]),
+    ] {
+        let (reused, fresh) = (dir.join(name), dir.join(format!("fresh-{name}")));
+        std::fs::write(&reused, &old).unwrap();
+        for path in [&fresh, &reused] {
+            let out = raytty(&["render", "--pixels", "16x8", "-o", path.to_str().unwrap()]);
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        assert_eq!(
+            std::fs::read(&reused).unwrap(),
+            std::fs::read(&fresh).unwrap(),
+            "{name}"
+        );
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -1,7 +1,7 @@
 //! `raytty render`: one frame to stdout or a file.
 
 use std::fs::File;
-use std::io::{self, BufWriter, IsTerminal, Write};
+use std::io::{self, BufWriter, IsTerminal, Seek, Write};
 
 use anyhow::Context;
 use clap::ValueEnum;
@@ -106,11 +106,23 @@ pub(super) fn run_render(
         )
         .into());
     }
-    // The output file is created before the (maybe long) render, so a bad path fails at once.
-    let mut out: Box<dyn Write> = match &args.output {
-        Some(path) => Box::new(BufWriter::new(
-            File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
-        )),
+    // The output file is opened before the (maybe long) render, so a bad path fails at once.
+    // It is not truncated here but after the write, to the length written: an existing file's
+    // pages are overwritten in place rather than freed and allocated again (a few ms for a
+    // 3 MB frame).
+    let file = match &args.output {
+        Some(path) => Some(
+            File::options()
+                .write(true)
+                .create(true)
+                .truncate(false)
+                .open(path)
+                .with_context(|| format!("cannot create {}", path.display()))?,
+        ),
+        None => None,
+    };
+    let mut out: Box<dyn Write + '_> = match &file {
+        Some(f) => Box::new(BufWriter::new(f)),
         None => Box::new(BufWriter::new(io::stdout().lock())),
     };
     let frame = if args.denoise == Switch::On {
@@ -130,14 +142,23 @@ pub(super) fn run_render(
             out.write_all(&encode_text(&CellGrid::from_image(&frame.image, mode)))
         }
     };
-    written.and_then(|()| out.flush()).with_context(|| {
-        format!(
-            "cannot write to {}",
-            args.output
-                .as_ref()
-                .map_or_else(|| "stdout".to_string(), |p| p.display().to_string())
-        )
-    })?;
+    written
+        .and_then(|()| out.flush())
+        .and_then(|()| {
+            drop(out);
+            match &file {
+                Some(f) if f.metadata()?.is_file() => f.set_len((&*f).stream_position()?),
+                _ => Ok(()),
+            }
+        })
+        .with_context(|| {
+            format!(
+                "cannot write to {}",
+                args.output
+                    .as_ref()
+                    .map_or_else(|| "stdout".to_string(), |p| p.display().to_string())
+            )
+        })?;
     match args.stats {
         Some(StatsFormat::Text) => {
             eprintln!("raytty: {w}x{h}, {}", frame.stats.summary(scene.isa()))
