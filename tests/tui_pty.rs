@@ -663,12 +663,22 @@ fn behind_a_deep_buffer_a_terminal_that_answers_paces_the_frames() {
         link.wait_for(TIMEOUT, |s| slow_link::max_error(s, &start) == 0),
         "the first frame never showed"
     );
-    link.send(b"wwwww");
+    // One step first, shown exact: by then the first frame's answer has measured the link
+    // (keys sent the instant the first frame shows would race that answer).
     let scene = cornell_box();
     let camera = scene.camera();
     let mut lights = scene.lights().to_vec();
-    for _ in 0..5 {
-        lights[0].position += camera.to_world(Vec3::new(0.0, 0.0, 1.0) * (0.1 * 1.0));
+    let step = camera.to_world(Vec3::new(0.0, 0.0, 1.0) * (0.1 * 1.0));
+    lights[0].position += step;
+    let one = slow_link::app_image(&camera, &lights, cols, rows);
+    link.send(b"w");
+    assert!(
+        link.wait_for(TIMEOUT, |s| slow_link::max_error(s, &one) == 0),
+        "the first step never showed"
+    );
+    link.send(b"wwww");
+    for _ in 0..4 {
+        lights[0].position += step;
     }
     let moved = slow_link::app_image(&camera, &lights, cols, rows);
     let mut seen_approximate = false;

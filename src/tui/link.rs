@@ -327,7 +327,13 @@ impl Acks {
         self.latency
     }
 
-    fn expire(&mut self, now: Instant) {
+    /// Whether answers are due: queries are unanswered and the terminal answers, or may.
+    pub fn outstanding(&self) -> bool {
+        !self.sent.is_empty() && matches!(self.state, AckState::On | AckState::Probing(_))
+    }
+
+    /// Stops asking if the first query has gone unanswered for [`ACK_PROBE_TIMEOUT`] at `now`.
+    pub fn expire(&mut self, now: Instant) {
         if let AckState::Probing(t) = self.state
             && now.saturating_duration_since(t) >= ACK_PROBE_TIMEOUT
         {
@@ -449,7 +455,7 @@ mod tests {
         assert_eq!(a.queries(t + 1000 * MS), (false, false));
         a.acked(t + 1500 * MS, &mut l);
         assert_eq!(a.queries(t + 2000 * MS), (false, false));
-        assert!(!a.on() && !a.waiting());
+        assert!(!a.on() && !a.waiting() && !a.outstanding());
         assert_eq!((l.rate(), l.budget()), (None, None));
     }
 

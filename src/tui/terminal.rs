@@ -40,6 +40,10 @@ const FORCED_EXIT_AFTER: Duration = Duration::from_secs(1);
 /// nothing (a stalled link).
 const WRITER_POLL: Duration = Duration::from_millis(100);
 
+/// While the terminal's answers are due and no frame is waiting, the writer looks for them
+/// this often.
+const ACK_POLL: Duration = Duration::from_millis(5);
+
 /// The writer never waits longer than this for the queue to drain before taking the next
 /// frame, whatever the link model says (a wrong estimate must not stall the app).
 const MAX_PACING_WAIT: Duration = Duration::from_millis(250);
@@ -75,6 +79,8 @@ enum Input {
     /// The writer is done with a frame (or could not write it), and what it now knows of the
     /// link.
     Written(io::Result<LinkView>),
+    /// The terminal's answers measured the link anew between frames.
+    Link(LinkView),
 }
 
 /// A frame for the writer, tagged with the terminal's epoch it was encoded for, and how long
@@ -222,7 +228,36 @@ fn spawn_writer_thread(tx: Sender<Input>, acks_rx: Receiver<Instant>) -> Sender<
     std::thread::spawn(move || {
         let mut link = Link::new(Instant::now());
         let mut acks = Acks::new();
-        for mut job in rx {
+        loop {
+            // While answers are due, look for them between frames too, so the loop's next
+            // frame already fits the link they measure.
+            let mut job = if acks.outstanding() {
+                match rx.recv_timeout(ACK_POLL) {
+                    Ok(job) => job,
+                    Err(mpsc::RecvTimeoutError::Timeout) => {
+                        let mut answered = false;
+                        while let Ok(at) = acks_rx.try_recv() {
+                            acks.acked(at, &mut link);
+                            answered = true;
+                        }
+                        acks.expire(Instant::now());
+                        let view = LinkView {
+                            budget: link.budget(),
+                            rate: link.rate(),
+                        };
+                        if answered && tx.send(Input::Link(view)).is_err() {
+                            return;
+                        }
+                        continue;
+                    }
+                    Err(mpsc::RecvTimeoutError::Disconnected) => return,
+                }
+            } else {
+                match rx.recv() {
+                    Ok(job) => job,
+                    Err(_) => return,
+                }
+            };
             while let Ok(at) = acks_rx.try_recv() {
                 acks.acked(at, &mut link);
             }
@@ -320,6 +355,7 @@ fn handle(
         }
         Input::Hangup => return Ok(Some(Outcome::Hangup)),
         Input::Signal(s) => return Ok(Some(Outcome::Signal(s))),
+        Input::Link(view) => screen.link = view,
         Input::Written(report) => {
             *busy = false;
             screen.link = report.context("cannot write to the terminal")?;
