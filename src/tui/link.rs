@@ -149,11 +149,13 @@ impl Link {
         });
     }
 
-    /// The terminal acknowledged at `now` everything written before a query: `bytes` took
-    /// `t` of link time to get there (a rate sample, if long enough), and `unacknowledged`
-    /// bytes written since are all that can still be queued.
-    pub fn acknowledged(&mut self, bytes: usize, t: Duration, unacknowledged: usize, now: Instant) {
-        self.sample(bytes, t);
+    /// The terminal acknowledged at `now` everything written before a query: `rate` is the
+    /// end-to-end rate the answers measure (if any yet), and `unacknowledged` bytes written
+    /// since are all that can still be queued.
+    pub fn acknowledged(&mut self, rate: Option<f64>, unacknowledged: usize, now: Instant) {
+        if rate.is_some() {
+            self.rate = rate;
+        }
         self.queued = unacknowledged as f64;
         self.at = now;
     }
@@ -188,6 +190,12 @@ pub const ACK_PROBE_TIMEOUT: Duration = Duration::from_secs(1);
 /// a whole unbudgeted first frame takes over a slow link.
 pub const ACK_WAIT: Duration = Duration::from_secs(2);
 
+/// The answers' rate is the least of the last this many frames' rates: a link with a token
+/// bucket (pv, a shaped uplink) or a terminal that reads in bursts lets some frames through at
+/// once after an idle spell, and an overestimate fills the buffers behind the pty, whereas an
+/// underestimate only makes a frame approximate for a little longer.
+const ACK_WINDOW: usize = 6;
+
 /// Whether the terminal acknowledges frames.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum AckState {
@@ -219,6 +227,8 @@ pub struct Acks {
     unqueried: Option<(Instant, usize)>,
     /// When the last acknowledgement arrived.
     last: Option<Instant>,
+    /// The latest per-frame rates (bytes per second), newest last, at most [`ACK_WINDOW`].
+    recent: std::collections::VecDeque<f64>,
     /// The least time from a write to its acknowledgement: the link's latency.
     latency: Option<Duration>,
 }
@@ -231,6 +241,7 @@ impl Acks {
             sent: Default::default(),
             unqueried: None,
             last: None,
+            recent: Default::default(),
             latency: None,
         }
     }
@@ -295,12 +306,15 @@ impl Acks {
         self.last = Some(now);
         let unacknowledged =
             self.sent.iter().map(|s| s.1).sum::<usize>() + self.unqueried.map_or(0, |u| u.1);
-        link.acknowledged(
-            bytes,
-            now.saturating_duration_since(begin),
-            unacknowledged,
-            now,
-        );
+        let t = now.saturating_duration_since(begin);
+        if t >= MIN_SAMPLE && bytes > 0 {
+            if self.recent.len() == ACK_WINDOW {
+                self.recent.pop_front();
+            }
+            self.recent.push_back(bytes as f64 / t.as_secs_f64());
+        }
+        let rate = self.recent.iter().copied().reduce(f64::min);
+        link.acknowledged(rate, unacknowledged, now);
     }
 
     /// Whether the writer should wait for an acknowledgement before taking the next frame:
@@ -436,6 +450,12 @@ mod tests {
         assert_eq!(l.budget(), Some(6_500));
         // The queue model knows a frame is still in flight.
         assert_eq!(l.queued(now), 20_000.0);
+        // A burst (20 kB answered 40 ms after the one before: 500 kB/s) does not raise it.
+        a.queries(now);
+        a.wrote(now, 20_000, false, true);
+        a.acked(now + 200 * MS, &mut l);
+        a.acked(now + 240 * MS, &mut l);
+        assert_eq!(l.rate(), Some(rate));
     }
 
     #[test]
