@@ -238,6 +238,8 @@ fn render_impl(
                 let mut tile_cache = TileCache::default();
                 for x0 in (0..w).step_by(TILE) {
                     let cols = (w - x0).min(TILE);
+                    // The tile's ray `i`, as an index into the band's rows.
+                    let at = |i: usize| i / cols * w + x0 + i % cols;
                     tile_rays.clear();
                     for dy in 0..rows {
                         rays.row(x0, cols, y0 + dy, &mut tile_rays);
@@ -252,11 +254,10 @@ fn render_impl(
                             &mut tile_cache,
                         );
                     }
-                    for (i, _) in tile_rays.iter().enumerate() {
-                        let at = i / cols * w + x0 + i % cols;
+                    for i in 0..k {
                         match hits {
-                            Some(h) if reuse => tile_hits[i] = h[at],
-                            Some(h) => h[at] = tile_hits[i],
+                            Some(h) if reuse => tile_hits[i] = h[at(i)],
+                            Some(h) => h[at(i)] = tile_hits[i],
                             None => {}
                         }
                     }
@@ -270,13 +271,12 @@ fn render_impl(
                             &mut scratch,
                         );
                         for (i, c) in colours.iter().enumerate() {
-                            pixels[i / cols * w + x0 + i % cols] = *c;
+                            pixels[at(i)] = *c;
                         }
                         continue;
                     }
                     for (i, ray) in tile_rays.iter().enumerate() {
                         let (dy, x) = (i / cols, x0 + i % cols);
-                        let at = dy * w + x;
                         let y = y0 + dy;
                         // Only path-traced light draws random numbers: skip the hash otherwise.
                         let mut rng = if draws {
@@ -285,7 +285,7 @@ fn render_impl(
                             Stream::Independent(Rng::seeded(0))
                         };
                         let g = guide_rows[dy].as_mut().map(|r| &mut r[x]);
-                        pixels[at] = sample(&tracer, ray, tile_hits[i], &mut rng, &mut n, g);
+                        pixels[at(i)] = sample(&tracer, ray, tile_hits[i], &mut rng, &mut n, g);
                     }
                 }
                 n
@@ -370,15 +370,12 @@ impl FrameStats {
 
     /// One line for people: time, samples, rays by kind, M rays/s and the SIMD path.
     pub fn summary(&self, isa: crate::accel::Isa) -> String {
-        let r = &self.rays;
+        let rays = self.rays.by_kind().map(|(kind, n)| format!("{n} {kind}"));
         format!(
-            "{:.2} ms, {} spp, rays: {} primary, {} shadow, {} bounce, {} reflection; {:.2} M rays/s ({}, {} threads)",
+            "{:.2} ms, {} spp, rays: {}; {:.2} M rays/s ({}, {} threads)",
             self.elapsed.as_secs_f64() * 1e3,
             self.samples,
-            r.primary,
-            r.shadow,
-            r.bounce,
-            r.reflection,
+            rays.join(", "),
             self.mrays_per_s(),
             isa.name(),
             rayon::current_num_threads()
@@ -388,15 +385,15 @@ impl FrameStats {
     /// The same as one JSON object: `ms`, `spp`, `rays` (by kind), `mrays_per_s`, and the
     /// `simd` path and `threads`.
     pub fn to_json(&self, isa: crate::accel::Isa) -> String {
-        let r = &self.rays;
+        let rays = self
+            .rays
+            .by_kind()
+            .map(|(kind, n)| format!("\"{kind}\":{n}"));
         format!(
-            "{{\"ms\":{:.3},\"spp\":{},\"rays\":{{\"primary\":{},\"shadow\":{},\"bounce\":{},\"reflection\":{}}},\"mrays_per_s\":{:.3},\"simd\":\"{}\",\"threads\":{}}}",
+            "{{\"ms\":{:.3},\"spp\":{},\"rays\":{{{}}},\"mrays_per_s\":{:.3},\"simd\":\"{}\",\"threads\":{}}}",
             self.elapsed.as_secs_f64() * 1e3,
             self.samples,
-            r.primary,
-            r.shadow,
-            r.bounce,
-            r.reflection,
+            rays.join(","),
             self.mrays_per_s(),
             isa.name(),
             rayon::current_num_threads()

@@ -4,12 +4,51 @@
 use crate::geometry::{Aabb, gamma};
 
 /// Four boxes, slab by slab: `min[axis][lane]`, `max[axis][lane]`. Unused lanes are empty
-/// boxes (min +∞, max −∞), which no ray meets.
+/// boxes (min +∞, max −∞); the slab test does not reject those (its near/far swap makes them
+/// everything), so callers mask them out (`Flat::lanes`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(16))]
 pub struct Box4 {
     min: [[f32; 4]; 3],
     max: [[f32; 4]; 3],
+}
+
+/// The portable slab test of `N` boxes held slab by slab (`min[axis][lane]`), one lane at a
+/// time: which the ray meets for some `t` in `[0, t_max]` (bit per lane) and where it enters
+/// each, [`Aabb::enter`]'s operations in its order (the far side widened by 1 + 2γ₃; a NaN
+/// slab distance constrains nothing). [`Box4`] and `Box8` share it.
+#[inline(always)]
+pub(crate) fn enter_lanes<const N: usize>(
+    min: &[[f32; N]; 3],
+    max: &[[f32; N]; 3],
+    origin: &[f32; 3],
+    inv_dir: &[f32; 3],
+    t_max: f32,
+) -> (u32, [f32; N]) {
+    let widen = 1.0 + 2.0 * gamma(3);
+    let mut t0 = [0.0f32; N];
+    let mut t1 = [t_max; N];
+    for axis in 0..3 {
+        for l in 0..N {
+            let a = (min[axis][l] - origin[axis]) * inv_dir[axis];
+            let b = (max[axis][l] - origin[axis]) * inv_dir[axis];
+            let (near, far) = if a > b { (b, a) } else { (a, b) };
+            let far = far * widen;
+            if near > t0[l] {
+                t0[l] = near;
+            }
+            if far < t1[l] {
+                t1[l] = far;
+            }
+        }
+    }
+    let mut mask = 0;
+    for l in 0..N {
+        if t0[l] <= t1[l] {
+            mask |= 1 << l;
+        }
+    }
+    (mask, t0)
 }
 
 impl Box4 {
@@ -39,30 +78,7 @@ impl Box4 {
         inv_dir: &[f32; 3],
         t_max: f32,
     ) -> (u32, [f32; 4]) {
-        let widen = 1.0 + 2.0 * gamma(3);
-        let mut t0 = [0.0f32; 4];
-        let mut t1 = [t_max; 4];
-        for axis in 0..3 {
-            for l in 0..4 {
-                let a = (self.min[axis][l] - origin[axis]) * inv_dir[axis];
-                let b = (self.max[axis][l] - origin[axis]) * inv_dir[axis];
-                let (near, far) = if a > b { (b, a) } else { (a, b) };
-                let far = far * widen;
-                if near > t0[l] {
-                    t0[l] = near;
-                }
-                if far < t1[l] {
-                    t1[l] = far;
-                }
-            }
-        }
-        let mut mask = 0;
-        for l in 0..4 {
-            if t0[l] <= t1[l] {
-                mask |= 1 << l;
-            }
-        }
-        (mask, t0)
+        enter_lanes(&self.min, &self.max, origin, inv_dir, t_max)
     }
 
     /// [`Box4::enter_portable`] with SSE2: the same operations four lanes at a time (SSE's

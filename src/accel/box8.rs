@@ -64,30 +64,7 @@ impl Box8 {
         inv_dir: &[f32; 3],
         t_max: f32,
     ) -> (u32, [f32; BOX_LANES]) {
-        let widen = 1.0 + 2.0 * gamma(3);
-        let mut t0 = [0.0f32; BOX_LANES];
-        let mut t1 = [t_max; BOX_LANES];
-        for axis in 0..3 {
-            for l in 0..BOX_LANES {
-                let a = (self.min[axis][l] - origin[axis]) * inv_dir[axis];
-                let b = (self.max[axis][l] - origin[axis]) * inv_dir[axis];
-                let (near, far) = if a > b { (b, a) } else { (a, b) };
-                let far = far * widen;
-                if near > t0[l] {
-                    t0[l] = near;
-                }
-                if far < t1[l] {
-                    t1[l] = far;
-                }
-            }
-        }
-        let mut mask = 0;
-        for l in 0..BOX_LANES {
-            if t0[l] <= t1[l] {
-                mask |= 1 << l;
-            }
-        }
-        (mask, t0)
+        super::box4::enter_lanes(&self.min, &self.max, origin, inv_dir, t_max)
     }
 
     /// [`Box8::enter_portable`] with SSE2, four lanes at a time: the same operations (SSE's

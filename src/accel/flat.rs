@@ -138,16 +138,8 @@ impl Flat {
             // SAFETY: the caller passes an available path.
             Isa::Avx2 => unsafe { occluded_each_avx2(self, rays, t_max, out) },
             #[cfg(target_arch = "x86_64")]
-            Isa::Sse2 => {
-                for (o, r) in out.iter_mut().zip(rays) {
-                    *o = occluded::<super::tri4::Sse2>(self, r, t_max);
-                }
-            }
-            _ => {
-                for (o, r) in out.iter_mut().zip(rays) {
-                    *o = occluded::<Portable>(self, r, t_max);
-                }
-            }
+            Isa::Sse2 => occluded_all::<super::tri4::Sse2>(self, rays, t_max, out),
+            _ => occluded_all::<Portable>(self, rays, t_max, out),
         }
     }
 
@@ -210,15 +202,21 @@ unsafe fn tile_avx2(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn occluded_each_avx2(f: &Flat, rays: &[Ray], t_max: f32, out: &mut [bool]) {
-    for (o, r) in out.iter_mut().zip(rays) {
-        *o = occluded::<super::tri4::Avx2>(f, r, t_max);
-    }
+    occluded_all::<super::tri4::Avx2>(f, rays, t_max, out);
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn occluded_avx2(f: &Flat, ray: &Ray, t_max: f32) -> bool {
     occluded::<super::tri4::Avx2>(f, ray, t_max)
+}
+
+/// [`occluded`] for each ray, into `out`.
+#[inline(always)]
+fn occluded_all<K: Kernel>(f: &Flat, rays: &[Ray], t_max: f32, out: &mut [bool]) {
+    for (o, r) in out.iter_mut().zip(rays) {
+        *o = occluded::<K>(f, r, t_max);
+    }
 }
 
 #[inline(always)]

@@ -27,33 +27,7 @@ pub struct Ray {
 impl Ray {
     /// A ray from `origin` along `dir`. `dir` must be finite and non-zero.
     pub fn new(origin: Vec3, dir: Vec3) -> Ray {
-        debug_assert!(origin.is_finite() && dir.is_finite(), "ray {origin} {dir}");
-        debug_assert!(dir != Vec3::ZERO, "zero ray direction");
-        let a = dir.abs();
-        let kz = if a.x > a.y {
-            if a.x > a.z { 0 } else { 2 }
-        } else if a.y > a.z {
-            1
-        } else {
-            2
-        };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if dir[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let sz = 1.0 / dir[kz];
-        Ray {
-            origin,
-            dir,
-            inv_dir: dir.recip(),
-            kx,
-            ky,
-            kz,
-            sx: -dir[kx] * sz,
-            sy: -dir[ky] * sz,
-            sz,
-        }
+        Ray::with_inverse(origin, dir, dir.recip())
     }
 
     /// [`Ray::new`] with `inv_dir` already computed: it must be `dir.recip()` (each component

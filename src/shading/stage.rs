@@ -129,6 +129,16 @@ impl RayCounts {
     pub fn total(&self) -> u64 {
         self.primary + self.shadow + self.bounce + self.reflection
     }
+
+    /// The counts by kind, named: primary, shadow, bounce, reflection.
+    pub fn by_kind(&self) -> [(&'static str, u64); 4] {
+        [
+            ("primary", self.primary),
+            ("shadow", self.shadow),
+            ("bounce", self.bounce),
+            ("reflection", self.reflection),
+        ]
+    }
 }
 
 impl std::ops::AddAssign for RayCounts {
