@@ -5,11 +5,13 @@
 //! extreme scales; whole frames are byte-identical whichever structure is used; and the BVH is
 //! the same with any number of threads.
 
+mod common;
+
+use common::{Rng, in_cube, soup, uniform};
 use glam::Vec3;
 use raytty::accel::BVH_THRESHOLD;
 use raytty::accel::bvh::{Bvh, MAX_DEPTH};
 use raytty::geometry::intersect_watertight;
-use raytty::rng::Rng;
 use raytty::scene::procedural::displaced_icosphere;
 use raytty::{
     AccelKind, Camera, Effects, Hit, Material, PointLight, Ray, Scene, SceneBuilder, Stage,
@@ -39,18 +41,6 @@ fn brute_occluded(triangles: &[Triangle], ray: &Ray, t_max: f32) -> bool {
         .any(|t| intersect_watertight(ray, &t.v, t_max).is_some())
 }
 
-fn uniform(rng: &mut Rng, lo: f32, hi: f32) -> f32 {
-    lo + (hi - lo) * rng.next_f32()
-}
-
-fn in_cube(rng: &mut Rng, half: f32) -> Vec3 {
-    Vec3::new(
-        uniform(rng, -half, half),
-        uniform(rng, -half, half),
-        uniform(rng, -half, half),
-    )
-}
-
 fn scene_of(triangles: Vec<[Vec3; 3]>, kind: AccelKind) -> Scene {
     let mut b = SceneBuilder::new();
     let m = b.material(Material::diffuse(Vec3::splat(0.7)));
@@ -61,21 +51,6 @@ fn scene_of(triangles: Vec<[Vec3; 3]>, kind: AccelKind) -> Scene {
     });
     b.accel(kind);
     b.build("test", Camera::default(), Effects::SEED).unwrap()
-}
-
-/// `n` random triangles with vertices within `size` of a centre in the cube of half-side
-/// `half`, all scaled by `scale`.
-fn soup(seed: u64, n: usize, half: f32, size: f32, scale: f32) -> Vec<[Vec3; 3]> {
-    let mut rng = Rng::seeded(seed);
-    let mut out = Vec::with_capacity(n);
-    while out.len() < n {
-        let c = in_cube(&mut rng, half);
-        let v = [0; 3].map(|_| (c + in_cube(&mut rng, size)) * scale);
-        if Triangle::new(v[0], v[1], v[2], 0).is_ok() {
-            out.push(v);
-        }
-    }
-    out
 }
 
 /// Seeded rays: random ones, and ones aimed at vertices and edge midpoints (where

@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::{Rng, in_cube, log_uniform, uniform, unit};
+use common::{Rng, in_cube, log_uniform, soup, uniform, unit};
 use glam::Vec3;
 use raytty::accel::box4::Box4;
 use raytty::accel::box8::Box8;
@@ -19,7 +19,7 @@ use raytty::geometry::{Aabb, TriHit, intersect_watertight};
 use raytty::scene::procedural::displaced_icosphere;
 use raytty::{
     AccelKind, Camera, Effects, Hit, Material, PointLight, Ray, Scene, SceneBuilder, Stage,
-    Triangle, cornell_box, render,
+    cornell_box, render,
 };
 
 /// The paths this CPU runs (always the portable one and, on x86-64, SSE2).
@@ -34,20 +34,6 @@ fn paths() -> Vec<Isa> {
         }
     }
     all
-}
-
-/// A triangle soup: `n` triangles of size `size` in a cube of half-side `half`, times `scale`.
-fn soup(seed: u64, n: usize, half: f32, size: f32, scale: f32) -> Vec<[Vec3; 3]> {
-    let mut rng = Rng::seeded(seed);
-    let mut out = Vec::with_capacity(n);
-    while out.len() < n {
-        let c = in_cube(&mut rng, half);
-        let v = [0; 3].map(|_| (c + in_cube(&mut rng, size)) * scale);
-        if Triangle::new(v[0], v[1], v[2], 0).is_ok() {
-            out.push(v);
-        }
-    }
-    out
 }
 
 /// Rays at the mesh's vertices and edge midpoints (ties between neighbours), random rays, and

@@ -1,4 +1,4 @@
-//! Helpers shared by the numerical-stability suite (`tests/stability_*.rs`): seeded random
+//! Helpers shared by the numerical-stability suite (`tests/stability_*.rs`), the accel and SIMD-kernel tests: seeded random
 //! cases, replayable case descriptions, the exact decision of the watertight test with its f32
 //! error bound, and an f64 reference tracer of a scene with edge-distance masks.
 //!
@@ -60,6 +60,21 @@ pub fn in_cube(rng: &mut Rng, half: f32) -> Vec3 {
         uniform(rng, -half, half),
         uniform(rng, -half, half),
     )
+}
+
+/// A triangle soup: `n` non-degenerate triangles with vertices within `size` of a centre in
+/// the cube of half-side `half`, all scaled by `scale`.
+pub fn soup(seed: u64, n: usize, half: f32, size: f32, scale: f32) -> Vec<[Vec3; 3]> {
+    let mut rng = Rng::seeded(seed);
+    let mut out = Vec::with_capacity(n);
+    while out.len() < n {
+        let c = in_cube(&mut rng, half);
+        let v = [0; 3].map(|_| (c + in_cube(&mut rng, size)) * scale);
+        if raytty::Triangle::new(v[0], v[1], v[2], 0).is_ok() {
+            out.push(v);
+        }
+    }
+    out
 }
 
 /// A uniformly distributed unit vector.
