@@ -1,6 +1,7 @@
-//! Helpers shared by the numerical-stability suite (`tests/stability_*.rs`), the accel and SIMD-kernel tests: seeded random
-//! cases, replayable case descriptions, the exact decision of the watertight test with its f32
-//! error bound, and an f64 reference tracer of a scene with edge-distance masks.
+//! Helpers shared by the numerical-stability suite (`tests/stability_*.rs`) and the accel and
+//! SIMD-kernel tests: seeded random cases and triangle soups, replayable case descriptions, the
+//! exact decision of the watertight test with its f32 error bound, and an f64 reference tracer
+//! of a scene with edge-distance masks.
 //!
 //! Every stability test draws its cases from [`Rng::seeded`] with a fixed seed per case, and
 //! prints [`case`] on failure: the seed, the ray and the triangle with every `f32` in its
