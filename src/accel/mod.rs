@@ -21,6 +21,7 @@ pub mod bvh;
 mod flat;
 mod hit;
 mod isa;
+pub mod shadow;
 pub mod tri4;
 
 use std::ops::Range;

@@ -11,6 +11,8 @@ use crate::geometry::{Ray, hit_point, offset_ray_origin};
 use crate::sampler::SampleSource;
 use crate::scene::{Indirect, Material, PointLight, Scene};
 
+#[cfg(target_arch = "x86_64")]
+mod lanes;
 mod split;
 mod stage;
 mod tile;
@@ -358,6 +360,11 @@ impl<'a> Tracer<'a> {
     ) {
         debug_assert!(self.shades_tiles());
         assert!(hits.len() == rays.len() && out.len() == rays.len());
+        #[cfg(target_arch = "x86_64")]
+        if self.shades_in_lanes() {
+            self.shade_tile_lanes(rays, hits, out, n, &mut scratch.lanes);
+            return;
+        }
         // Per pixel being shaded here: the hit point, its error, the normal facing the ray,
         // and where it goes in `out`.
         let TileScratch {
@@ -366,6 +373,7 @@ impl<'a> Tracer<'a> {
             terms,
             rays: shadows,
             blocked,
+            ..
         } = scratch;
         at.clear();
         for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
@@ -441,6 +449,9 @@ pub struct TileScratch {
     terms: Vec<Option<(Vec3, Option<Ray>)>>,
     rays: Vec<Ray>,
     blocked: Vec<bool>,
+    /// What [`Tracer::shade_tile_lanes`] keeps.
+    #[cfg(target_arch = "x86_64")]
+    lanes: Box<lanes::LaneScratch>,
 }
 
 /// A cosine-weighted direction on the hemisphere around `n` (unit length).

@@ -31,6 +31,8 @@ use crate::geometry::Ray;
 mod portable;
 mod search;
 #[cfg(target_arch = "x86_64")]
+pub mod shadow;
+#[cfg(target_arch = "x86_64")]
 mod x86;
 
 pub(crate) use search::{Closest, blocks_closest, blocks_occluded};

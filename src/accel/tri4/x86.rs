@@ -155,6 +155,7 @@ macro_rules! watertight_lanes {
         }
     }};
 }
+pub(super) use watertight_lanes;
 
 /// Four lanes of SSE2, under the names [`watertight_lanes`] uses. SAFETY (of every `unsafe`
 /// here): SSE2 is part of every x86-64 CPU; these take and return registers only.
@@ -243,7 +244,7 @@ mod sse {
 
 /// Eight lanes of AVX, under the names [`watertight_lanes`] uses. Compiled for AVX2 (the path's
 /// feature), so they inline into the AVX2 kernels.
-mod avx {
+pub(super) mod avx {
     use std::arch::x86_64::*;
 
     pub type V = __m256;
