@@ -5,12 +5,28 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// One test's folder of files, removed when the test ends (passed or failed).
+struct Scratch(PathBuf);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
 /// A fresh folder for one test's files.
-fn dir(test: &str) -> PathBuf {
+fn dir(test: &str) -> Scratch {
     let d = std::env::temp_dir().join(format!("raytty-scene-errors-{}-{test}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
-    d
+    Scratch(d)
 }
 
 /// Runs `raytty render --scene FILE` on `scene` written to `d/scene.toml`, expects exit status
