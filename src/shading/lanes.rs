@@ -15,7 +15,7 @@ use glam::Vec3;
 use super::{Mode, RayCounts, SHADOW_EPSILON, Tracer};
 use crate::accel::shadow::{SHADOW_TILE_TRIANGLES, ShadowCull, ShadowRays8};
 use crate::accel::{Hit, Isa, TILE_RAYS};
-use crate::geometry::{Ray, gamma};
+use crate::geometry::{Ray, RayTile, gamma};
 use crate::scene::{Indirect, PointLight};
 
 /// Most pixels in a tile.
@@ -83,7 +83,7 @@ impl Tracer<'_> {
     /// [`Tracer::shades_in_lanes`].
     pub(super) fn shade_tile_lanes(
         &self,
-        rays: &[Ray],
+        rays: &RayTile,
         hits: &[Option<Hit>],
         out: &mut [Vec3],
         n: &mut RayCounts,
@@ -98,7 +98,7 @@ impl Tracer<'_> {
     #[allow(clippy::needless_range_loop)] // lanes and axes, in step across several arrays
     unsafe fn shade_tile_avx2(
         &self,
-        rays: &[Ray],
+        rays: &RayTile,
         hits: &[Option<Hit>],
         out: &mut [Vec3],
         n: &mut RayCounts,
@@ -108,7 +108,7 @@ impl Tracer<'_> {
         let (tris, materials) = (self.scene.triangles(), self.scene.materials());
         // Gather the pixels shaded here; the others are shaded one at a time.
         let mut m = 0;
-        for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+        for (i, hit) in hits.iter().enumerate() {
             let Some(hit) = hit else {
                 out[i] = Vec3::ZERO;
                 continue;
@@ -121,16 +121,18 @@ impl Tracer<'_> {
                     && !(material.mirror > 0.0)
                     && material.colour != Vec3::ZERO);
             if !own {
-                out[i] = self.shade_primary(ray, Some(*hit), &mut crate::rng::Rng::seeded(0), n);
+                let ray = rays.ray(i);
+                out[i] = self.shade_primary(&ray, Some(*hit), &mut crate::rng::Rng::seeded(0), n);
                 continue;
             }
+            let dir = rays.dir(i);
             for k in 0..3 {
                 s.bary[k][m] = hit.b[k];
                 for j in 0..3 {
                     s.v[j][k][m] = tri.v[j][k];
                 }
                 s.tri_normal[k][m] = tri.normal[k];
-                s.ray_dir[k][m] = ray.dir[k];
+                s.ray_dir[k][m] = dir[k];
                 s.colour[k][m] = material.colour[k];
             }
             s.idx[m] = i as u8;
