@@ -7,10 +7,12 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use crate::accel::Hit;
-use crate::geometry::{Ray, hit_point, offset_ray_origin};
+use crate::geometry::{Ray, RayTile, hit_point, offset_ray_origin};
 use crate::sampler::SampleSource;
 use crate::scene::{Indirect, Material, PointLight, Scene};
 
+#[cfg(target_arch = "x86_64")]
+mod lanes;
 mod split;
 mod stage;
 mod tile;
@@ -350,7 +352,7 @@ impl<'a> Tracer<'a> {
     /// with shading. Only for frames that [`Tracer::shades_tiles`].
     pub fn shade_tile(
         &self,
-        rays: &[Ray],
+        rays: &RayTile,
         hits: &[Option<Hit>],
         out: &mut [Vec3],
         n: &mut RayCounts,
@@ -358,6 +360,11 @@ impl<'a> Tracer<'a> {
     ) {
         debug_assert!(self.shades_tiles());
         assert!(hits.len() == rays.len() && out.len() == rays.len());
+        #[cfg(target_arch = "x86_64")]
+        if self.shades_in_lanes() {
+            self.shade_tile_lanes(rays, hits, out, n, &mut scratch.lanes);
+            return;
+        }
         // Per pixel being shaded here: the hit point, its error, the normal facing the ray,
         // and where it goes in `out`.
         let TileScratch {
@@ -366,9 +373,10 @@ impl<'a> Tracer<'a> {
             terms,
             rays: shadows,
             blocked,
+            ..
         } = scratch;
         at.clear();
-        for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+        for (i, hit) in hits.iter().enumerate() {
             let Some(hit) = hit else {
                 out[i] = Vec3::ZERO;
                 continue;
@@ -382,11 +390,12 @@ impl<'a> Tracer<'a> {
                     && !(material.mirror > 0.0)
                     && material.colour != Vec3::ZERO);
             if !own {
-                out[i] = self.shade_primary(ray, Some(*hit), &mut crate::rng::Rng::seeded(0), n);
+                let ray = rays.ray(i);
+                out[i] = self.shade_primary(&ray, Some(*hit), &mut crate::rng::Rng::seeded(0), n);
                 continue;
             }
             let (p, err) = hit_point(&tri.v, hit.b);
-            let normal = if tri.normal.dot(ray.dir) > 0.0 {
+            let normal = if tri.normal.dot(rays.dir(i)) > 0.0 {
                 -tri.normal
             } else {
                 tri.normal
@@ -441,6 +450,9 @@ pub struct TileScratch {
     terms: Vec<Option<(Vec3, Option<Ray>)>>,
     rays: Vec<Ray>,
     blocked: Vec<bool>,
+    /// What [`Tracer::shade_tile_lanes`] keeps.
+    #[cfg(target_arch = "x86_64")]
+    lanes: Box<lanes::LaneScratch>,
 }
 
 /// A cosine-weighted direction on the hemisphere around `n` (unit length).

@@ -1,0 +1,59 @@
+//! Shadow rays eight at a time: one triangle against eight rays that share their axes but not
+//! their origins (a tile's rays toward a point light), any hit only. Each lane runs the
+//! scalar test's operations ([`super::x86`]'s `watertight_lanes`, the kernel of every path)
+//! on its own origin and shear, so a lane is reported hit exactly when
+//! [`crate::geometry::intersect_watertight`] accepts it; a lane whose edge function rounds to
+//! 0 is handed back (`redo`) for the scalar test's `f64` edges.
+
+use glam::Vec3;
+
+use super::LANES;
+use super::x86::{avx, watertight_lanes};
+use crate::geometry::gamma;
+
+/// Up to eight rays with the same axes (`kx`, `ky`, `kz`), lane by lane: each origin in that
+/// axis order and each shear, as [`crate::geometry::Ray`] holds them.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(32))]
+pub struct ShadowRays8 {
+    /// Per lane: `origin[kx]`, `origin[ky]`, `origin[kz]`.
+    pub origin: [[f32; 2 * LANES]; 3],
+    /// Per lane: `sx`, `sy`, `sz` ([`crate::geometry::Ray::shear`]).
+    pub shear: [[f32; 2 * LANES]; 3],
+    /// The lanes' common axes ([`crate::geometry::Ray::axes`]).
+    pub axes: [usize; 3],
+}
+
+/// Which lanes of `rays` hit triangle `v` before `t_max` (bit per lane), and which lanes the
+/// scalar test must redo (an edge function rounded to 0). Lanes that hold no ray give
+/// meaningless bits: callers mask them.
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[target_feature(enable = "avx2")]
+#[inline]
+pub unsafe fn any_hit8_avx2(v: &[Vec3; 3], rays: &ShadowRays8, t_max: f32) -> (u32, u32) {
+    use avx::*;
+    use std::arch::x86_64::*;
+    // SAFETY: every load reads a whole 32-byte-aligned `[f32; 8]`.
+    let load = |p: &[f32; 8]| unsafe { _mm256_load_ps(p.as_ptr()) };
+    let [kx, ky, kz] = rays.axes;
+    let [ox, oy, oz] = rays.origin.each_ref().map(load);
+    // `RayFrame`: each vertex relative to each lane's origin, in the axis order.
+    let rel = |p: Vec3| {
+        (
+            sub(splat(p[kx]), ox),
+            sub(splat(p[ky]), oy),
+            sub(splat(p[kz]), oz),
+        )
+    };
+    let ((a0, b0, z0), (a1, b1, z1), (a2, b2, z2)) = (rel(v[0]), rel(v[1]), rel(v[2]));
+    let [sx, sy, sz] = rays.shear.each_ref().map(load);
+    let (hit, redo, ..) = watertight_lanes!(
+        avx,
+        [a0, b0, z0, a1, b1, z1, a2, b2, z2],
+        [sx, sy, sz],
+        splat(t_max)
+    );
+    (hit, redo)
+}
