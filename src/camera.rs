@@ -2,7 +2,7 @@
 
 use glam::{Mat3, Vec3};
 
-use crate::geometry::Ray;
+use crate::geometry::{Ray, RayTile, TILE_RAYS};
 
 /// A pinhole camera at `position`, turned by `yaw` about the y axis (y points down) and tilted
 /// by `pitch` about its right axis. With yaw = pitch = 0 it looks along +z.
@@ -94,78 +94,152 @@ impl RayGen {
 }
 
 impl RayGen {
-    /// Appends the rays through the centres of pixels `x0..x0 + n` of row `y` to `out`: each
-    /// is `self.ray(x + 0.5, y + 0.5)` bit for bit, made eight at a time with AVX2 where the CPU
-    /// has it (the same operations in the same order, so the same rounding).
-    pub fn row(&self, x0: usize, n: usize, y: usize, out: &mut Vec<Ray>) {
+    /// Makes `out` the tile of rays through the centres of pixels `x0..x0 + cols` of rows
+    /// `y0..y0 + rows` (`cols`, `rows` ≤ 8), ray `r·cols + c` through pixel (x0 + c, y0 + r):
+    /// each is `self.ray(x + 0.5, y + 0.5)` bit for bit, with its shear when the tile's rays
+    /// share their axes. Made eight at a time with AVX2 where the CPU has it (the same
+    /// operations in the same order, so the same rounding).
+    pub fn tile(&self, x0: usize, y0: usize, cols: usize, rows: usize, out: &mut RayTile) {
+        assert!(
+            (1..=8).contains(&cols) && (1..=8).contains(&rows),
+            "a tile is 1 to 8 pixels on a side"
+        );
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
-            let mut x = x0;
-            while x < x0 + n {
-                let k = (x0 + n - x).min(8);
-                // SAFETY: the CPU has AVX2 (checked above).
-                unsafe { self.row8_avx2(x, k, y, out) };
-                x += k;
-            }
+            // SAFETY: the CPU has AVX2 (checked above).
+            unsafe { self.tile_avx2(x0, y0, cols, rows, out) };
             return;
         }
-        self.row_scalar(x0, n, y, out);
+        self.tile_scalar(x0, y0, cols, rows, out);
     }
 
-    /// [`RayGen::row`] one ray at a time.
-    pub fn row_scalar(&self, x0: usize, n: usize, y: usize, out: &mut Vec<Ray>) {
-        out.extend((x0..x0 + n).map(|x| self.ray(x as f32 + 0.5, y as f32 + 0.5)));
+    /// [`RayGen::tile`] one ray at a time.
+    pub fn tile_scalar(&self, x0: usize, y0: usize, cols: usize, rows: usize, out: &mut RayTile) {
+        let rays: Vec<Ray> = (y0..y0 + rows)
+            .flat_map(|y| (x0..x0 + cols).map(move |x| (x, y)))
+            .map(|(x, y)| self.ray(x as f32 + 0.5, y as f32 + 0.5))
+            .collect();
+        *out = RayTile::from_rays(&rays);
     }
 
-    /// Up to eight rays of [`RayGen::row`] at once.
+    /// [`RayGen::tile`] a row of eight rays at a time.
     ///
     /// # Safety
     /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn row8_avx2(&self, x0: usize, n: usize, y: usize, out: &mut Vec<Ray>) {
+    unsafe fn tile_avx2(&self, x0: usize, y0: usize, cols: usize, rows: usize, out: &mut RayTile) {
         use std::arch::x86_64::*;
-        debug_assert!(n <= 8);
-        let xs: [f32; 8] = std::array::from_fn(|i| (x0 + i.min(n - 1)) as f32 + 0.5);
         let splat = |v: f32| _mm256_set1_ps(v);
+        // Columns past the tile's repeat its last one: every lane is a ray of the tile.
+        let xs: [f32; 8] = std::array::from_fn(|i| (x0 + i.min(cols - 1)) as f32 + 0.5);
         // SAFETY: reads eight `f32`s.
         let dx = _mm256_sub_ps(unsafe { _mm256_loadu_ps(xs.as_ptr()) }, splat(self.half_w));
-        let dy = splat((y as f32 + 0.5) - self.half_h);
         let dz = splat(self.focal);
         let m = &self.rotation;
-        // `Mat3 * Vec3`: x_axis·d.x + y_axis·d.y + z_axis·d.z, in that order.
-        let axis = |x: f32, y: f32, z: f32| {
-            _mm256_add_ps(
-                _mm256_add_ps(_mm256_mul_ps(splat(x), dx), _mm256_mul_ps(splat(y), dy)),
-                _mm256_mul_ps(splat(z), dz),
-            )
-        };
-        let rx = axis(m.x_axis.x, m.y_axis.x, m.z_axis.x);
-        let ry = axis(m.x_axis.y, m.y_axis.y, m.z_axis.y);
-        let rz = axis(m.x_axis.z, m.y_axis.z, m.z_axis.z);
-        // `normalize`: times 1 / sqrt(x·x + y·y + z·z).
-        let len2 = _mm256_add_ps(
-            _mm256_add_ps(_mm256_mul_ps(rx, rx), _mm256_mul_ps(ry, ry)),
-            _mm256_mul_ps(rz, rz),
-        );
         let one = splat(1.0);
-        let rcp = _mm256_div_ps(one, _mm256_sqrt_ps(len2));
-        let d = [rx, ry, rz].map(|r| _mm256_mul_ps(r, rcp));
-        let inv = d.map(|c| _mm256_div_ps(one, c));
-        let mut dir = [[0f32; 8]; 3];
-        let mut inv_dir = [[0f32; 8]; 3];
-        for k in 0..3 {
-            // SAFETY: each store writes eight `f32`s.
-            unsafe {
-                _mm256_storeu_ps(dir[k].as_mut_ptr(), d[k]);
-                _mm256_storeu_ps(inv_dir[k].as_mut_ptr(), inv[k]);
+        let sign = splat(-0.0);
+        // The common axes: (kz, dir[kz] < 0) of the first row, `None` once a lane differs.
+        let mut common: Option<(usize, bool)> = None;
+        let mut mixed = false;
+        let (mut sx_lo, mut sx_hi) = (splat(f32::INFINITY), splat(f32::NEG_INFINITY));
+        let (mut sy_lo, mut sy_hi) = (sx_lo, sx_hi);
+        for r in 0..rows {
+            let dy = splat((((y0 + r) as f32) + 0.5) - self.half_h);
+            // `Mat3 * Vec3`: x_axis·d.x + y_axis·d.y + z_axis·d.z, in that order.
+            let axis = |x: f32, y: f32, z: f32| {
+                _mm256_add_ps(
+                    _mm256_add_ps(_mm256_mul_ps(splat(x), dx), _mm256_mul_ps(splat(y), dy)),
+                    _mm256_mul_ps(splat(z), dz),
+                )
+            };
+            let rx = axis(m.x_axis.x, m.y_axis.x, m.z_axis.x);
+            let ry = axis(m.x_axis.y, m.y_axis.y, m.z_axis.y);
+            let rz = axis(m.x_axis.z, m.y_axis.z, m.z_axis.z);
+            // `normalize`: times 1 / sqrt(x·x + y·y + z·z).
+            let len2 = _mm256_add_ps(
+                _mm256_add_ps(_mm256_mul_ps(rx, rx), _mm256_mul_ps(ry, ry)),
+                _mm256_mul_ps(rz, rz),
+            );
+            let rcp = _mm256_div_ps(one, _mm256_sqrt_ps(len2));
+            let d = [rx, ry, rz].map(|c| _mm256_mul_ps(c, rcp));
+            let at = r * cols;
+            debug_assert!(at + 8 <= TILE_RAYS);
+            for (k, c) in d.iter().enumerate() {
+                // SAFETY: `at + 8 <= TILE_RAYS`: eight `f32`s inside the row.
+                unsafe { _mm256_storeu_ps(out.dir[k][at..].as_mut_ptr(), *c) };
             }
+            if mixed {
+                continue;
+            }
+            // `Ray::new`'s axes, lane by lane: kz is 0 where |x| > |y| and |x| > |z|, 1 where
+            // not |x| > |y| but |y| > |z|, else 2.
+            let a = d.map(|c| _mm256_andnot_ps(sign, c));
+            let gt = |p: __m256, q: __m256| _mm256_cmp_ps::<_CMP_GT_OQ>(p, q);
+            let (xy, xz, yz) = (gt(a[0], a[1]), gt(a[0], a[2]), gt(a[1], a[2]));
+            let kz0 = _mm256_movemask_ps(_mm256_and_ps(xy, xz));
+            let kz1 = _mm256_movemask_ps(_mm256_andnot_ps(xy, yz));
+            let kz = match (kz0, kz1) {
+                (0xff, 0) => 0,
+                (0, 0xff) => 1,
+                (0, 0) => 2,
+                _ => {
+                    mixed = true;
+                    continue;
+                }
+            };
+            let neg = match _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(d[kz], splat(0.0))) {
+                0 => false,
+                0xff => true,
+                _ => {
+                    mixed = true;
+                    continue;
+                }
+            };
+            if *common.get_or_insert((kz, neg)) != (kz, neg) {
+                mixed = true;
+                continue;
+            }
+            let kx = (kz + 1) % 3;
+            let ky = (kx + 1) % 3;
+            let (kx, ky) = if neg { (ky, kx) } else { (kx, ky) };
+            // `sz = 1/dir[kz]`, `sx = −dir[kx]·sz`, `sy = −dir[ky]·sz`.
+            let sz = _mm256_div_ps(one, d[kz]);
+            let sx = _mm256_mul_ps(_mm256_xor_ps(d[kx], sign), sz);
+            let sy = _mm256_mul_ps(_mm256_xor_ps(d[ky], sign), sz);
+            for (k, s) in [sx, sy, sz].iter().enumerate() {
+                // SAFETY: as above.
+                unsafe { _mm256_storeu_ps(out.shear[k][at..].as_mut_ptr(), *s) };
+            }
+            sx_lo = _mm256_min_ps(sx_lo, sx);
+            sx_hi = _mm256_max_ps(sx_hi, sx);
+            sy_lo = _mm256_min_ps(sy_lo, sy);
+            sy_hi = _mm256_max_ps(sy_hi, sy);
         }
-        for l in 0..n {
-            let dir = Vec3::new(dir[0][l], dir[1][l], dir[2][l]);
-            let inv = Vec3::new(inv_dir[0][l], inv_dir[1][l], inv_dir[2][l]);
-            out.push(Ray::with_inverse(self.origin, dir, inv));
-        }
+        out.origin = self.origin;
+        out.len = rows * cols;
+        out.axes = match common {
+            Some((kz, neg)) if !mixed => {
+                let kx = (kz + 1) % 3;
+                let ky = (kx + 1) % 3;
+                Some(if neg { [ky, kx, kz] } else { [kx, ky, kz] })
+            }
+            _ => None,
+        };
+        let lanes = |v: __m256| {
+            let mut a = [0f32; 8];
+            // SAFETY: writes eight `f32`s.
+            unsafe { _mm256_storeu_ps(a.as_mut_ptr(), v) };
+            a
+        };
+        let fold =
+            |v: __m256, f: fn(f32, f32) -> f32| lanes(v).into_iter().reduce(f).unwrap_or(0.0);
+        out.shear_box = [
+            fold(sx_lo, f32::min),
+            fold(sx_hi, f32::max),
+            fold(sy_lo, f32::min),
+            fold(sy_hi, f32::max),
+        ];
     }
 }
 
@@ -184,12 +258,12 @@ mod tests {
         assert_eq!(cam.down(), Vec3::Y);
     }
 
+    /// Every ray of tiles of four cameras and image sizes equals `RayGen::ray` bit for bit
+    /// (direction, and axes and shear when shared), with AVX2 and one at a time.
     #[test]
-    fn rows_of_rays_are_single_rays_bit_for_bit() {
-        let bits = |r: &Ray| {
-            let v = [r.origin, r.dir, r.inv_dir].map(|v| v.to_array().map(f32::to_bits));
-            (v, r.axes(), r.shear().map(f32::to_bits))
-        };
+    fn tiles_of_rays_are_single_rays_bit_for_bit() {
+        let mut tiles = 0;
+        let mut shared = 0;
         for (i, (w, h)) in [(500, 500), (37, 91), (1920, 1080), (3, 1)]
             .into_iter()
             .enumerate()
@@ -200,28 +274,67 @@ mod tests {
                 pitch: 0.3 * i as f32 - 0.5,
             };
             let g = cam.rays(w, h);
-            for y in [0, h as usize / 2, h as usize - 1] {
-                let (mut fast, mut slow) = (vec![], vec![]);
-                g.row(0, w as usize, y, &mut fast);
-                g.row_scalar(0, w as usize, y, &mut slow);
-                let one: Vec<Ray> = (0..w as usize)
-                    .map(|x| g.ray(x as f32 + 0.5, y as f32 + 0.5))
-                    .collect();
-                assert_eq!(fast.len(), one.len());
-                for x in 0..one.len() {
-                    assert_eq!(
-                        bits(&fast[x]),
-                        bits(&one[x]),
-                        "{w}x{h} camera {i}: ({x}, {y})"
-                    );
-                    assert_eq!(
-                        bits(&slow[x]),
-                        bits(&one[x]),
-                        "{w}x{h} camera {i}: ({x}, {y})"
-                    );
+            let (w, h) = (w as usize, h as usize);
+            let (mut fast, mut slow) = (RayTile::default(), RayTile::default());
+            for y0 in (0..h).step_by(8).filter(|y| y % 24 == 0 || y + 8 >= h) {
+                for x0 in (0..w).step_by(8) {
+                    let (cols, rows) = ((w - x0).min(8), (h - y0).min(8));
+                    g.tile(x0, y0, cols, rows, &mut fast);
+                    g.tile_scalar(x0, y0, cols, rows, &mut slow);
+                    tiles += 1;
+                    let one: Vec<Ray> = (0..rows * cols)
+                        .map(|j| {
+                            let (x, y) = (x0 + j % cols, y0 + j / cols);
+                            g.ray(x as f32 + 0.5, y as f32 + 0.5)
+                        })
+                        .collect();
+                    let axes = one.iter().all(|r| r.axes() == one[0].axes());
+                    shared += axes as usize;
+                    for t in [&fast, &slow] {
+                        assert_eq!(t.len(), one.len());
+                        assert_eq!(t.origin(), cam.position);
+                        assert_eq!(t.axes(), axes.then(|| one[0].axes()));
+                        let mut b = [
+                            f32::INFINITY,
+                            f32::NEG_INFINITY,
+                            f32::INFINITY,
+                            f32::NEG_INFINITY,
+                        ];
+                        for (j, r) in one.iter().enumerate() {
+                            let at = format!("{w}x{h} camera {i}: tile ({x0}, {y0}) ray {j}");
+                            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                            assert_eq!(bits(t.dir(j)), bits(r.dir), "{at}");
+                            let tr = t.ray(j);
+                            assert_eq!(bits(tr.inv_dir), bits(r.inv_dir), "{at}");
+                            assert_eq!(tr.shear().map(f32::to_bits), r.shear().map(f32::to_bits));
+                            if axes {
+                                let s = t.shear_lanes();
+                                let s = [s[0][j], s[1][j], s[2][j]];
+                                assert_eq!(
+                                    s.map(f32::to_bits),
+                                    r.shear().map(f32::to_bits),
+                                    "{at}"
+                                );
+                                b = [
+                                    b[0].min(s[0]),
+                                    b[1].max(s[0]),
+                                    b[2].min(s[1]),
+                                    b[3].max(s[1]),
+                                ];
+                            }
+                        }
+                        if axes {
+                            assert_eq!(t.shear_box(), b, "{w}x{h} camera {i}: ({x0}, {y0})");
+                        }
+                    }
                 }
             }
         }
+        // Both kinds of tiles were seen.
+        assert!(
+            shared > 100 && shared < tiles,
+            "{shared} of {tiles} tiles share axes"
+        );
     }
 
     #[test]

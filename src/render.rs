@@ -12,6 +12,7 @@ use rayon::prelude::*;
 use crate::accel::{Hit, TILE_RAYS, TileCache};
 use crate::camera::Camera;
 use crate::denoise::{GuidePixel, Guides, denoise};
+use crate::geometry::RayTile;
 use crate::image::Image;
 use crate::rng::Rng;
 use crate::sampler::{SampleSource, Sampler, Stream};
@@ -231,7 +232,7 @@ fn render_impl(
             .map(|(band, ((pixels, hits), guide_rows))| {
                 let mut n = RayCounts::default();
                 let (y0, rows) = (band * TILE, guide_rows.len());
-                let mut tile_rays = Vec::with_capacity(TILE_RAYS);
+                let mut tile_rays = RayTile::default();
                 let mut tile_hits = [None; TILE_RAYS];
                 let mut tile_colours = [Vec3::ZERO; TILE_RAYS];
                 let mut scratch = TileScratch::default();
@@ -240,10 +241,7 @@ fn render_impl(
                     let cols = (w - x0).min(TILE);
                     // The tile's ray `i`, as an index into the band's rows.
                     let at = |i: usize| i / cols * w + x0 + i % cols;
-                    tile_rays.clear();
-                    for dy in 0..rows {
-                        rays.row(x0, cols, y0 + dy, &mut tile_rays);
-                    }
+                    rays.tile(x0, y0, cols, rows, &mut tile_rays);
                     let k = tile_rays.len();
                     if !reuse {
                         n.primary += k as u64;
@@ -275,7 +273,8 @@ fn render_impl(
                         }
                         continue;
                     }
-                    for (i, ray) in tile_rays.iter().enumerate() {
+                    for i in 0..k {
+                        let ray = &tile_rays.ray(i);
                         let (dy, x) = (i / cols, x0 + i % cols);
                         let y = y0 + dy;
                         // Only path-traced light draws random numbers: skip the hash otherwise.

@@ -15,7 +15,7 @@ use raytty::accel::box4::Box4;
 use raytty::accel::box8::Box8;
 use raytty::accel::tri4::{Hits, Tri4, hits as hits_in, hits2};
 use raytty::accel::{Isa, TileCache};
-use raytty::geometry::{Aabb, TriHit, intersect_watertight};
+use raytty::geometry::{Aabb, RayTile, TriHit, intersect_watertight};
 use raytty::scene::procedural::displaced_icosphere;
 use raytty::{
     AccelKind, Camera, Effects, Hit, Material, PointLight, Ray, Scene, SceneBuilder, Stage,
@@ -315,13 +315,7 @@ fn structures_on_every_path_match_brute_force() {
 /// vertex, an edge's midpoint or a random point of `tris`, spaced from 1e-7 to 0.3 of the
 /// distance, some with a ray exactly through a vertex (an edge function of 0) and some from
 /// an origin on a triangle's plane.
-fn tiles(
-    seed: u64,
-    tris: &[[Vec3; 3]],
-    n: usize,
-    reach: f32,
-    centre: Vec3,
-) -> Vec<(Vec<Ray>, f32)> {
+fn tiles(seed: u64, tris: &[[Vec3; 3]], n: usize, reach: f32, centre: Vec3) -> Vec<(RayTile, f32)> {
     let mut rng = Rng::seeded(seed);
     (0..n)
         .map(|i| {
@@ -363,24 +357,25 @@ fn tiles(
             } else {
                 f32::INFINITY
             };
-            (rays, t_max)
+            (RayTile::from_rays(&rays), t_max)
         })
         .collect()
 }
 
 /// `Scene::intersect_tile` on both structures and every path gives each ray of a tile the
 /// brute-force hit, bit for bit (`t`, barycentrics, index), one cache kept across all tiles.
-fn assert_tiles_agree(objects: &[Vec<[Vec3; 3]>], tiles: &[(Vec<Ray>, f32)], what: &str) {
+fn assert_tiles_agree(objects: &[Vec<[Vec3; 3]>], tiles: &[(RayTile, f32)], what: &str) {
     let tris: Vec<[Vec3; 3]> = objects.concat();
     for kind in [AccelKind::Flat, AccelKind::Bvh] {
         let scene = scene_of(objects, kind);
         for isa in paths() {
             let s = scene.clone().with_isa(isa).expect("available");
             let mut cache = TileCache::default();
-            for (i, (rays, t_max)) in tiles.iter().enumerate() {
-                let mut hits = vec![None; rays.len()];
-                s.intersect_tile(rays, *t_max, &mut hits, &mut cache);
-                for (r, (ray, got)) in rays.iter().zip(&hits).enumerate() {
+            for (i, (tile, t_max)) in tiles.iter().enumerate() {
+                let mut hits = vec![None; tile.len()];
+                s.intersect_tile(tile, *t_max, &mut hits, &mut cache);
+                for (r, got) in hits.iter().enumerate() {
+                    let ray = &tile.ray(r);
                     let want = brute_force(&tris, ray, *t_max);
                     assert_eq!(
                         got.map(|h| (h.t.to_bits(), h.b.map(f32::to_bits), h.triangle)),
@@ -418,17 +413,22 @@ fn tiles_of_rays_on_every_path_match_brute_force() {
     let objects: Vec<Vec<[Vec3; 3]>> = vec![scene.triangles().iter().map(|t| t.v).collect()];
     let cam = scene.camera();
     let mut rng = Rng::seeded(27);
-    let tiles: Vec<(Vec<Ray>, f32)> = (0..200)
+    // The camera's own tiles (`RayGen::tile`), whole and cut at the image's edges.
+    let tiles: Vec<(RayTile, f32)> = (0..200)
         .map(|_| {
             let g = Camera {
                 position: cam.position + in_cube(&mut rng, 0.8),
                 yaw: uniform(&mut rng, -3.0, 3.0),
                 pitch: uniform(&mut rng, -1.0, 1.0),
             }
-            .rays(64, 48);
-            let (x0, y0) = ((rng.next_u64() % 56) as f32, (rng.next_u64() % 40) as f32);
-            let rays = (0..64).map(|i| g.ray(x0 + (i % 8) as f32 + 0.5, y0 + (i / 8) as f32 + 0.5));
-            (rays.collect(), f32::INFINITY)
+            .rays(61, 45);
+            let (x0, y0) = (
+                (rng.next_u64() % 61) as usize,
+                (rng.next_u64() % 45) as usize,
+            );
+            let mut tile = RayTile::default();
+            g.tile(x0, y0, (61 - x0).min(8), (45 - y0).min(8), &mut tile);
+            (tile, f32::INFINITY)
         })
         .collect();
     assert_tiles_agree(&objects, &tiles, "cornell cameras");

@@ -15,11 +15,11 @@ use super::tri4::{
 };
 use glam::Vec3;
 
-use crate::geometry::{Aabb, Ray, Triangle};
+use crate::geometry::{Aabb, Ray, RayTile, Triangle};
 
 mod tile;
 
-pub use tile::{TILE_RAYS, TileCache};
+pub use tile::TileCache;
 
 /// Objects sorted by entry distance on the stack; a list with more is visited in order.
 const SORTED_MAX: usize = 64;
@@ -101,13 +101,13 @@ impl Flat {
         }
     }
 
-    /// The closest hits of `rays` into `hits` (as many), each as [`Flat::intersect`] gives it,
-    /// on path `isa` (must be available). Rays that share their origin and axes (a tile of
-    /// camera rays, at most [`TILE_RAYS`]) are tested together.
+    /// The closest hits of `tile`'s rays into `hits` (as many), each as [`Flat::intersect`]
+    /// gives it, on path `isa` (must be available). A tile whose rays share their axes (as a
+    /// camera's do) is tested eight rays at a time.
     pub fn intersect_tile(
         &self,
         isa: Isa,
-        rays: &[Ray],
+        tile: &RayTile,
         t_max: f32,
         hits: &mut [Option<Hit>],
         cache: &mut TileCache,
@@ -116,14 +116,14 @@ impl Flat {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller passes an available path.
-            Isa::Avx2 => unsafe { tile_avx2(self, rays, t_max, hits, cache) },
+            Isa::Avx2 => unsafe { tile_avx2(self, tile, t_max, hits, cache) },
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => {
-                tile::intersect_tile::<super::tri4::Sse2>(self, rays, t_max, hits, cache, |r| {
+                tile::intersect_tile::<super::tri4::Sse2>(self, tile, t_max, hits, cache, |r| {
                     closest::<super::tri4::Sse2>(self, r, t_max)
                 })
             }
-            _ => tile::intersect_tile::<Portable>(self, rays, t_max, hits, cache, |r| {
+            _ => tile::intersect_tile::<Portable>(self, tile, t_max, hits, cache, |r| {
                 closest::<Portable>(self, r, t_max)
             }),
         }
@@ -189,12 +189,12 @@ unsafe fn closest_avx2(f: &Flat, ray: &Ray, t_max: f32) -> Option<Hit> {
 #[target_feature(enable = "avx2")]
 unsafe fn tile_avx2(
     f: &Flat,
-    rays: &[Ray],
+    tile: &RayTile,
     t_max: f32,
     hits: &mut [Option<Hit>],
     cache: &mut TileCache,
 ) {
-    tile::intersect_tile::<super::tri4::Avx2>(f, rays, t_max, hits, cache, |r| {
+    tile::intersect_tile::<super::tri4::Avx2>(f, tile, t_max, hits, cache, |r| {
         closest::<super::tri4::Avx2>(f, r, t_max)
     });
 }

@@ -27,11 +27,12 @@ pub mod tri4;
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
-use crate::geometry::{Ray, Triangle};
+use crate::geometry::{Ray, RayTile, Triangle};
 use bvh::Bvh;
 use flat::Flat;
 
-pub use flat::{TILE_RAYS, TileCache};
+pub use crate::geometry::TILE_RAYS;
+pub use flat::TileCache;
 pub use hit::{CULL_SLACK, Hit, cull_bound, shrunk_t_max};
 pub use isa::Isa;
 
@@ -187,21 +188,21 @@ impl Accel {
         }
     }
 
-    /// The closest hits of `rays` into `hits` (as many), each as [`Accel::intersect`] gives
-    /// it. The flat list tests rays that share origin and axes (a tile of camera rays, at most
-    /// [`TILE_RAYS`]) together, keeping what tiles of one camera share in `cache`.
+    /// The closest hits of `tile`'s rays into `hits` (as many), each as [`Accel::intersect`]
+    /// gives it. The flat list tests a tile whose rays share their axes (a camera's) eight
+    /// rays at a time, keeping what tiles of one camera share in `cache`.
     pub fn intersect_tile(
         &self,
-        rays: &[Ray],
+        tile: &RayTile,
         t_max: f32,
         hits: &mut [Option<Hit>],
         cache: &mut TileCache,
     ) {
         match &self.structure {
-            Structure::Flat(flat) => flat.intersect_tile(self.isa, rays, t_max, hits, cache),
+            Structure::Flat(flat) => flat.intersect_tile(self.isa, tile, t_max, hits, cache),
             Structure::Bvh(bvh) => {
-                for (h, r) in hits.iter_mut().zip(rays) {
-                    *h = bvh.intersect(r, t_max);
+                for (i, h) in hits.iter_mut().enumerate() {
+                    *h = bvh.intersect(&tile.ray(i), t_max);
                 }
             }
         }

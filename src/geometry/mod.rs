@@ -12,6 +12,7 @@ mod aabb;
 mod float;
 mod offset;
 mod ray;
+mod ray_tile;
 mod triangle;
 mod watertight;
 
@@ -19,6 +20,7 @@ pub use aabb::Aabb;
 pub use float::{gamma, next_float_down, next_float_up};
 pub use offset::{hit_point, offset_ray_origin};
 pub use ray::{Ray, RayFrame};
+pub use ray_tile::{RayTile, TILE_RAYS};
 pub use triangle::{DegenerateTriangle, Triangle};
 pub use watertight::{TriHit, intersect_watertight, t_error_bound};
 

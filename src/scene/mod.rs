@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 use crate::accel::{Accel, AccelKind, AccelStats, Hit, Isa, TileCache};
 use crate::camera::Camera;
-use crate::geometry::{Aabb, DegenerateTriangle, Ray, Triangle};
+use crate::geometry::{Aabb, DegenerateTriangle, Ray, RayTile, Triangle};
 use crate::sampler::Sampler;
 
 /// Largest absolute coordinate accepted anywhere a user gives one (scene files, OBJ vertices,
@@ -329,19 +329,19 @@ impl Scene {
         self.accel.intersect(ray, t_max)
     }
 
-    /// The closest hits of `rays` into `hits` (as many), each as [`Scene::intersect`] gives
-    /// it; camera rays of one tile (sharing origin and axes, at most
-    /// [`crate::accel::TILE_RAYS`]) are tested together where the structure can, keeping what
-    /// tiles of one camera share in `cache` (start with `TileCache::default()`).
+    /// The closest hits of `tile`'s rays into `hits` (as many), each as [`Scene::intersect`]
+    /// gives it; a tile whose rays share their axes (a camera's) is tested eight rays at a
+    /// time where the structure can, keeping what tiles of one camera share in `cache` (start
+    /// with `TileCache::default()`).
     #[inline]
     pub fn intersect_tile(
         &self,
-        rays: &[Ray],
+        tile: &RayTile,
         t_max: f32,
         hits: &mut [Option<Hit>],
         cache: &mut TileCache,
     ) {
-        self.accel.intersect_tile(rays, t_max, hits, cache)
+        self.accel.intersect_tile(tile, t_max, hits, cache)
     }
 
     /// [`Scene::occluded`] for each of `rays`, into `out` (as many).

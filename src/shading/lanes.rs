@@ -15,7 +15,7 @@ use glam::Vec3;
 use super::{Mode, RayCounts, SHADOW_EPSILON, Tracer};
 use crate::accel::shadow::{SHADOW_TILE_TRIANGLES, ShadowCull, ShadowRays8};
 use crate::accel::{Hit, Isa, TILE_RAYS};
-use crate::geometry::{Ray, gamma};
+use crate::geometry::{Ray, RayTile, gamma};
 use crate::scene::{Indirect, PointLight};
 
 /// Most pixels in a tile.
@@ -90,7 +90,7 @@ impl Tracer<'_> {
     /// [`Tracer::shades_in_lanes`].
     pub(super) fn shade_tile_lanes(
         &self,
-        rays: &[Ray],
+        rays: &RayTile,
         hits: &[Option<Hit>],
         out: &mut [Vec3],
         n: &mut RayCounts,
@@ -105,7 +105,7 @@ impl Tracer<'_> {
     #[allow(clippy::needless_range_loop)] // lanes and axes, in step across several arrays
     unsafe fn shade_tile_avx2(
         &self,
-        rays: &[Ray],
+        rays: &RayTile,
         hits: &[Option<Hit>],
         out: &mut [Vec3],
         n: &mut RayCounts,
@@ -115,7 +115,7 @@ impl Tracer<'_> {
         let tables = &**self.tables.get_or_init(|| Box::new(self.tables()));
         // Gather the pixels shaded here; the others are shaded one at a time, after.
         let k = rays.len().min(N);
-        let (rays, hits) = (&rays[..k], &hits[..k]);
+        let hits = &hits[..k];
         let mut m = 0;
         let mut others = 0u64;
         for i in 0..k {
@@ -127,7 +127,7 @@ impl Tracer<'_> {
             others |= (own ^ 1) << i;
             // (`m < N`: the mask only tells the compiler so.)
             let j = m & (N - 1);
-            let dir = rays[i].dir;
+            let dir = rays.dir(i);
             s.bary[0][j] = hit.b[0];
             s.bary[1][j] = hit.b[1];
             s.bary[2][j] = hit.b[2];
@@ -142,7 +142,7 @@ impl Tracer<'_> {
             let i = others.trailing_zeros() as usize;
             others &= others - 1;
             let mut rng = crate::rng::Rng::seeded(0);
-            out[i] = self.shade_primary(&rays[i], hits[i], &mut rng, n);
+            out[i] = self.shade_primary(&rays.ray(i), hits[i], &mut rng, n);
         }
         if m == 0 {
             return;

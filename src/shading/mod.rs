@@ -7,7 +7,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use crate::accel::Hit;
-use crate::geometry::{Ray, hit_point, offset_ray_origin};
+use crate::geometry::{Ray, RayTile, hit_point, offset_ray_origin};
 use crate::sampler::SampleSource;
 use crate::scene::{Indirect, Material, PointLight, Scene};
 
@@ -357,7 +357,7 @@ impl<'a> Tracer<'a> {
     /// with shading. Only for frames that [`Tracer::shades_tiles`].
     pub fn shade_tile(
         &self,
-        rays: &[Ray],
+        rays: &RayTile,
         hits: &[Option<Hit>],
         out: &mut [Vec3],
         n: &mut RayCounts,
@@ -381,7 +381,7 @@ impl<'a> Tracer<'a> {
             ..
         } = scratch;
         at.clear();
-        for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+        for (i, hit) in hits.iter().enumerate() {
             let Some(hit) = hit else {
                 out[i] = Vec3::ZERO;
                 continue;
@@ -395,11 +395,12 @@ impl<'a> Tracer<'a> {
                     && !(material.mirror > 0.0)
                     && material.colour != Vec3::ZERO);
             if !own {
-                out[i] = self.shade_primary(ray, Some(*hit), &mut crate::rng::Rng::seeded(0), n);
+                let ray = rays.ray(i);
+                out[i] = self.shade_primary(&ray, Some(*hit), &mut crate::rng::Rng::seeded(0), n);
                 continue;
             }
             let (p, err) = hit_point(&tri.v, hit.b);
-            let normal = if tri.normal.dot(ray.dir) > 0.0 {
+            let normal = if tri.normal.dot(rays.dir(i)) > 0.0 {
                 -tri.normal
             } else {
                 tri.normal

@@ -27,17 +27,12 @@ use glam::Vec3;
 
 use super::Flat;
 use crate::accel::hit::Hit;
-use crate::accel::tri4::{Best8, Kernel, Rays8};
-use crate::geometry::{Ray, gamma, intersect_watertight};
-
-/// Most rays in one tile.
-pub const TILE_RAYS: usize = 64;
+use crate::accel::tri4::{Best8, Kernel};
+use crate::geometry::{Ray, RayTile, TILE_RAYS, gamma, intersect_watertight};
 
 /// Flat lists of more triangles than this answer tiles one ray at a time: the cull looks at
 /// every triangle once per tile, which pays while triangles are few.
 const TILE_TRIANGLES: usize = 64;
-
-const _: () = assert!(TILE_TRIANGLES <= 256, "kept triangles are indexed by a u8");
 
 /// What the flat list keeps between tiles of one camera: each triangle relative to the rays'
 /// common origin, with its edge functions' affine coefficients and cull margins. Start with
@@ -160,72 +155,62 @@ fn may_hit(t: &TileTri, sx: (f64, f64), sy: (f64, f64)) -> bool {
     !(neg && pos)
 }
 
-/// The closest hits of `rays` (at most [`TILE_RAYS`], sharing origin and axes, else answered
-/// one at a time by `one`) into `hits`, each as [`Flat::intersect`] gives it.
+/// The closest hits of `tile`'s rays into `hits` (as many), each as [`Flat::intersect`] gives
+/// it; a tile whose rays do not share their axes, or a list of too many triangles, is
+/// answered one ray at a time by `one`.
 #[inline(always)]
 pub(super) fn intersect_tile<K: Kernel>(
     f: &Flat,
-    rays: &[Ray],
+    tile: &RayTile,
     t_max: f32,
     hits: &mut [Option<Hit>],
     cache: &mut TileCache,
     one: impl Fn(&Ray) -> Option<Hit>,
 ) {
-    debug_assert_eq!(rays.len(), hits.len());
-    let Some(first) = rays.first() else { return };
-    let (origin, axes) = (first.origin, first.axes());
-    if rays.len() > TILE_RAYS
-        || f.tris.len() > TILE_TRIANGLES
-        || rays.iter().any(|r| r.origin != origin || r.axes() != axes)
-    {
-        for (h, r) in hits.iter_mut().zip(rays) {
-            *h = one(r);
+    let n = tile.len();
+    debug_assert_eq!(n, hits.len());
+    let axes = match tile.axes() {
+        Some(axes) if f.tris.len() <= TILE_TRIANGLES && n > 0 => axes,
+        _ => {
+            for (i, h) in hits.iter_mut().enumerate() {
+                *h = one(&tile.ray(i));
+            }
+            return;
         }
-        return;
-    }
+    };
     // The box of the tile's shears.
-    let (mut sx, mut sy) = (
-        (f32::INFINITY, f32::NEG_INFINITY),
-        (f32::INFINITY, f32::NEG_INFINITY),
-    );
-    for r in rays {
-        let [x, y, _] = r.shear();
-        sx = (sx.0.min(x), sx.1.max(x));
-        sy = (sy.0.min(y), sy.1.max(y));
-    }
+    let [sx0, sx1, sy0, sy1] = tile.shear_box();
     cache.prepare(
         f,
-        origin,
+        tile.origin(),
         axes,
-        sx.0.abs().max(sx.1.abs()),
-        sy.0.abs().max(sy.1.abs()),
+        sx0.abs().max(sx1.abs()),
+        sy0.abs().max(sy1.abs()),
     );
-    let (sx, sy) = ((sx.0 as f64, sx.1 as f64), (sy.0 as f64, sy.1 as f64));
+    let (sx, sy) = ((sx0 as f64, sx1 as f64), (sy0 as f64, sy1 as f64));
+    let packets = n.div_ceil(8);
+    let lanes = if n == TILE_RAYS {
+        u64::MAX
+    } else {
+        (1 << n) - 1
+    };
+    let mut best = [Best8::NONE; TILE_RAYS / 8];
+    let best = &mut best[..packets];
     // The triangles that survive the cull, in index order.
-    let mut kept = [0u8; TILE_TRIANGLES];
-    let mut n = 0;
-    for (i, t) in cache.tris.iter().enumerate() {
-        if may_hit(t, sx, sy) {
-            kept[n] = i as u8;
-            n += 1;
+    for t in cache.tris.iter() {
+        if !may_hit(t, sx, sy) {
+            continue;
         }
-    }
-    for (rays, hits) in rays.chunks(8).zip(hits.chunks_mut(8)) {
-        let packet = Rays8::new(rays);
-        let mut best = Best8::NONE;
-        for &i in &kept[..n] {
-            let t = &cache.tris[i as usize];
-            let mut redo = K::rays(&t.v, &t.rel, rays, &packet, t_max, t.id, &mut best);
-            while redo != 0 {
-                let l = redo.trailing_zeros() as usize;
-                redo &= redo - 1;
-                if let Some(h) = intersect_watertight(&rays[l], &t.v, t_max) {
-                    best.offer(l, h.t, h.b, t.id);
-                }
+        let mut redo = K::rays(&t.v, &t.rel, tile, t_max, t.id, best) & lanes;
+        while redo != 0 {
+            let l = redo.trailing_zeros() as usize;
+            redo &= redo - 1;
+            if let Some(h) = intersect_watertight(&tile.ray(l), &t.v, t_max) {
+                best[l / 8].offer(l % 8, h.t, h.b, t.id);
             }
         }
-        for (l, h) in hits.iter_mut().enumerate() {
-            *h = best.hit(l);
-        }
+    }
+    for (l, h) in hits.iter_mut().enumerate() {
+        *h = best[l / 8].hit(l % 8);
     }
 }

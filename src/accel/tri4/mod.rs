@@ -26,7 +26,7 @@ use glam::Vec3;
 use super::box4::Box4;
 use super::hit::Hit;
 use super::isa::Isa;
-use crate::geometry::Ray;
+use crate::geometry::{Ray, RayTile};
 
 mod portable;
 mod search;
@@ -176,39 +176,6 @@ impl Hits {
     }
 }
 
-/// Up to eight rays that share an origin and axes, lane by lane (their shear): what the
-/// ray-lane kernels read. Unused lanes repeat lane 0.
-#[derive(Clone, Copy, Debug)]
-#[repr(C, align(32))]
-pub struct Rays8 {
-    shear: [[f32; 2 * LANES]; 3],
-    count: usize,
-}
-
-impl Rays8 {
-    /// The first eight of `rays` (at least one), which must share their axes.
-    #[inline]
-    pub fn new(rays: &[Ray]) -> Rays8 {
-        let mut shear = [[0.0; 2 * LANES]; 3];
-        for l in 0..2 * LANES {
-            let s = rays[if l < rays.len() { l } else { 0 }].shear();
-            for (row, v) in shear.iter_mut().zip(s) {
-                row[l] = v;
-            }
-        }
-        Rays8 {
-            shear,
-            count: rays.len().min(2 * LANES),
-        }
-    }
-
-    /// The mask of the lanes that hold a ray.
-    #[inline]
-    pub fn lanes(&self) -> u32 {
-        (1 << self.count) - 1
-    }
-}
-
 /// Each of eight rays' closest hit so far: `t` (∞ for none yet), barycentrics and triangle.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
@@ -259,17 +226,18 @@ pub(crate) trait Kernel {
     /// Which of four boxes the ray meets before `t_max`, and where it enters them.
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]);
     /// Triangle `id` (vertices `v`; `rel` relative to the rays' common origin in their axis
-    /// order) against up to eight `rays` at once (`packet`), folded into `best`. Returns the
-    /// lanes the caller must test with the scalar test (its `f64` redo).
+    /// order) against the rays of `tile` (which share their axes) eight at a time, folded into
+    /// `best` (eight rays each, as many as the tile has packets of eight). Returns the rays
+    /// the caller must test with the scalar test (its `f64` redo); bits from `tile.len()` on
+    /// are meaningless.
     fn rays(
         v: &[Vec3; 3],
         rel: &[[f32; 3]; 3],
-        rays: &[Ray],
-        packet: &Rays8,
+        tile: &RayTile,
         t_max: f32,
         id: u32,
-        best: &mut Best8,
-    ) -> u32;
+        best: &mut [Best8],
+    ) -> u64;
 }
 
 /// The portable path.
@@ -292,15 +260,14 @@ impl Kernel for Portable {
     fn rays(
         v: &[Vec3; 3],
         _: &[[f32; 3]; 3],
-        rays: &[Ray],
-        packet: &Rays8,
+        tile: &RayTile,
         t_max: f32,
         id: u32,
-        best: &mut Best8,
-    ) -> u32 {
-        for (l, ray) in rays.iter().enumerate().take(packet.count) {
-            if let Some(h) = crate::geometry::intersect_watertight(ray, v, t_max) {
-                best.offer(l, h.t, h.b, id);
+        best: &mut [Best8],
+    ) -> u64 {
+        for l in 0..tile.len() {
+            if let Some(h) = crate::geometry::intersect_watertight(&tile.ray(l), v, t_max) {
+                best[l / 8].offer(l % 8, h.t, h.b, id);
             }
         }
         0
@@ -329,13 +296,12 @@ impl Kernel for Sse2 {
     fn rays(
         _: &[Vec3; 3],
         rel: &[[f32; 3]; 3],
-        _: &[Ray],
-        packet: &Rays8,
+        tile: &RayTile,
         t_max: f32,
         id: u32,
-        best: &mut Best8,
-    ) -> u32 {
-        x86::rays_sse2(rel, packet, t_max, id, best) & packet.lanes()
+        best: &mut [Best8],
+    ) -> u64 {
+        x86::rays_sse2(rel, tile, t_max, id, best)
     }
 }
 
@@ -364,14 +330,13 @@ impl Kernel for Avx2 {
     fn rays(
         _: &[Vec3; 3],
         rel: &[[f32; 3]; 3],
-        _: &[Ray],
-        packet: &Rays8,
+        tile: &RayTile,
         t_max: f32,
         id: u32,
-        best: &mut Best8,
-    ) -> u32 {
+        best: &mut [Best8],
+    ) -> u64 {
         // SAFETY: `Avx2` is only instantiated behind a check that the CPU has AVX2.
-        unsafe { x86::rays_avx2(rel, packet, t_max, id, best) & packet.lanes() }
+        unsafe { x86::rays_avx2(rel, tile, t_max, id, best) }
     }
 }
 

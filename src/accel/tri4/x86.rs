@@ -10,8 +10,8 @@
 
 use std::arch::x86_64::*;
 
-use super::{Best8, Hits, LANES, RayLanes, Rays8, Tri4};
-use crate::geometry::gamma;
+use super::{Best8, Hits, LANES, RayLanes, Tri4};
+use crate::geometry::{RayTile, gamma};
 
 /// The watertight test of one ray against every lane of `$load`'s triangles, with the
 /// operations of module `$o`: the ray's constants splatted, the vertices loaded.
@@ -414,8 +414,10 @@ pub unsafe fn hits_avx2(block: &Tri4, r: &RayLanes, t_max: f32) -> Hits {
 const _: () = assert!(LANES == 4);
 
 /// One triangle (`rel`: its vertices relative to the rays' common origin, in their axis
-/// order) against eight rays at once with AVX2, folded into `best` (lanes that hit it nearer
-/// than their best so far take it, as `id`). Returns the lanes to redo with the scalar test.
+/// order) against `tile`'s rays eight at a time with AVX2, folded into `best` (one per packet
+/// of eight rays: lanes that hit it nearer than their best so far take it, as `id`). Returns
+/// the rays to redo with the scalar test (bits from `tile.len()` on are meaningless). The
+/// triangle's lanes are set up once for all packets.
 ///
 /// # Safety
 /// The CPU must have AVX2.
@@ -423,79 +425,90 @@ const _: () = assert!(LANES == 4);
 #[inline]
 pub unsafe fn rays_avx2(
     rel: &[[f32; 3]; 3],
-    rays: &Rays8,
+    tile: &RayTile,
     t_max: f32,
     id: u32,
-    best: &mut Best8,
-) -> u32 {
+    best: &mut [Best8],
+) -> u64 {
     use avx::*;
-    // SAFETY: every load and store reads or writes a whole 32-byte-aligned `[f32; 8]`.
-    let load = |p: &[f32; 8]| unsafe { _mm256_load_ps(p.as_ptr()) };
     // (A closure: a `target_feature` function is not a `FnMut`.)
     #[allow(clippy::redundant_closure)]
     let [[a0, b0, z0], [a1, b1, z1], [a2, b2, z2]] = rel.map(|v| v.map(|x| splat(x)));
-    let (mask, redo, t, w0, w1, w2, accepted) = watertight_lanes!(
-        avx,
-        [a0, b0, z0, a1, b1, z1, a2, b2, z2],
-        [
-            load(&rays.shear[0]),
-            load(&rays.shear[1]),
-            load(&rays.shear[2])
-        ],
-        splat(t_max)
-    );
-    if mask != 0 {
-        let best_t = load(&best.t);
-        let take = and(accepted, lt(t, best_t));
-        // SAFETY: as above; the ids are moved as bits.
-        unsafe {
-            let ids = _mm256_castsi256_ps(_mm256_load_si256(best.id.as_ptr().cast()));
-            _mm256_store_ps(best.t.as_mut_ptr(), select(take, best_t, t));
-            for (b, w) in best.b.iter_mut().zip([w0, w1, w2]) {
-                _mm256_store_ps(b.as_mut_ptr(), select(take, load(b), w));
-            }
-            let id = _mm256_castsi256_ps(_mm256_set1_epi32(id as i32));
-            let ids = _mm256_castps_si256(select(take, ids, id));
-            _mm256_store_si256(best.id.as_mut_ptr().cast(), ids);
-        }
-    }
-    redo
-}
-
-/// [`rays_avx2`] with SSE2, four lanes at a time.
-#[inline(always)]
-pub fn rays_sse2(rel: &[[f32; 3]; 3], rays: &Rays8, t_max: f32, id: u32, best: &mut Best8) -> u32 {
-    use sse::*;
-    let [[a0, b0, z0], [a1, b1, z1], [a2, b2, z2]] = rel.map(|v| v.map(splat));
+    let t_max = splat(t_max);
+    let id = _mm256_castsi256_ps(_mm256_set1_epi32(id as i32));
     let mut redo_all = 0;
-    for half in [0, LANES] {
-        // SAFETY: every load and store reads or writes four of eight `f32`s, 16-byte aligned.
-        let load = |p: &[f32; 8]| unsafe { _mm_load_ps(p[half..].as_ptr()) };
+    for (p, best) in best.iter_mut().enumerate() {
+        let at = 8 * p;
+        // SAFETY: every load and store reads or writes eight `f32`s, 32-byte aligned (the
+        // tile's lanes are aligned and `at` is a multiple of 8 below `TILE_RAYS`).
+        let load = |p: &[f32]| unsafe { _mm256_load_ps(p[..8].as_ptr()) };
+        let s = &tile.shear;
         let (mask, redo, t, w0, w1, w2, accepted) = watertight_lanes!(
-            sse,
+            avx,
             [a0, b0, z0, a1, b1, z1, a2, b2, z2],
-            [
-                load(&rays.shear[0]),
-                load(&rays.shear[1]),
-                load(&rays.shear[2])
-            ],
-            splat(t_max)
+            [load(&s[0][at..]), load(&s[1][at..]), load(&s[2][at..])],
+            t_max
         );
-        redo_all |= redo << half;
+        redo_all |= (redo as u64) << at;
         if mask != 0 {
             let best_t = load(&best.t);
             let take = and(accepted, lt(t, best_t));
             // SAFETY: as above; the ids are moved as bits.
             unsafe {
-                let ids = _mm_castsi128_ps(_mm_load_si128(best.id[half..].as_ptr().cast()));
-                _mm_store_ps(best.t[half..].as_mut_ptr(), select(take, best_t, t));
+                let ids = _mm256_castsi256_ps(_mm256_load_si256(best.id.as_ptr().cast()));
+                _mm256_store_ps(best.t.as_mut_ptr(), select(take, best_t, t));
                 for (b, w) in best.b.iter_mut().zip([w0, w1, w2]) {
-                    let old = _mm_load_ps(b[half..].as_ptr());
-                    _mm_store_ps(b[half..].as_mut_ptr(), select(take, old, w));
+                    _mm256_store_ps(b.as_mut_ptr(), select(take, load(b), w));
                 }
-                let id = _mm_castsi128_ps(_mm_set1_epi32(id as i32));
-                let ids = _mm_castps_si128(select(take, ids, id));
-                _mm_store_si128(best.id[half..].as_mut_ptr().cast(), ids);
+                let ids = _mm256_castps_si256(select(take, ids, id));
+                _mm256_store_si256(best.id.as_mut_ptr().cast(), ids);
+            }
+        }
+    }
+    redo_all
+}
+
+/// [`rays_avx2`] with SSE2, four lanes at a time.
+#[inline(always)]
+pub fn rays_sse2(
+    rel: &[[f32; 3]; 3],
+    tile: &RayTile,
+    t_max: f32,
+    id: u32,
+    best: &mut [Best8],
+) -> u64 {
+    use sse::*;
+    let [[a0, b0, z0], [a1, b1, z1], [a2, b2, z2]] = rel.map(|v| v.map(splat));
+    let t_max = splat(t_max);
+    let mut redo_all = 0;
+    for (p, best) in best.iter_mut().enumerate() {
+        for half in [0, LANES] {
+            let at = 8 * p + half;
+            // SAFETY: every load and store reads or writes four `f32`s, 16-byte aligned.
+            let load = |p: &[f32]| unsafe { _mm_load_ps(p[..4].as_ptr()) };
+            let s = &tile.shear;
+            let (mask, redo, t, w0, w1, w2, accepted) = watertight_lanes!(
+                sse,
+                [a0, b0, z0, a1, b1, z1, a2, b2, z2],
+                [load(&s[0][at..]), load(&s[1][at..]), load(&s[2][at..])],
+                t_max
+            );
+            redo_all |= (redo as u64) << at;
+            if mask != 0 {
+                let best_t = load(&best.t[half..]);
+                let take = and(accepted, lt(t, best_t));
+                // SAFETY: as above; the ids are moved as bits.
+                unsafe {
+                    let ids = _mm_castsi128_ps(_mm_load_si128(best.id[half..].as_ptr().cast()));
+                    _mm_store_ps(best.t[half..].as_mut_ptr(), select(take, best_t, t));
+                    for (b, w) in best.b.iter_mut().zip([w0, w1, w2]) {
+                        let old = _mm_load_ps(b[half..].as_ptr());
+                        _mm_store_ps(b[half..].as_mut_ptr(), select(take, old, w));
+                    }
+                    let id = _mm_castsi128_ps(_mm_set1_epi32(id as i32));
+                    let ids = _mm_castps_si128(select(take, ids, id));
+                    _mm_store_si128(best.id[half..].as_mut_ptr().cast(), ids);
+                }
             }
         }
     }
