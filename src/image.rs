@@ -54,31 +54,48 @@ impl Image {
         writer.finish().map_err(png_io_error)
     }
 
-    /// Writes a PFM: linear little-endian f32 RGB, bottom row first, as the format requires.
-    /// The rows go out as they lie in memory (on a little-endian CPU, a row of `Vec3` is its
-    /// PFM bytes), in as few vectored writes as the writer takes: no copy, no per-pixel work.
+    /// Writes a PFM: linear little-endian f32 RGB, bottom row first, as the format requires
+    /// ([`pfm_header`], then [`write_pfm_rows`] of every row).
     pub fn write_pfm(&self, mut w: impl Write) -> io::Result<()> {
-        write!(w, "PF\n{} {}\n-1.0\n", self.width, self.height)?;
-        let width = self.width as usize;
-        if width == 0 {
-            return Ok(());
-        }
-        #[cfg(target_endian = "little")]
-        {
-            let rows: Vec<&[u8]> = self.pixels.chunks_exact(width).rev().map(bytes).collect();
-            let mut slices: Vec<io::IoSlice> = rows.iter().map(|r| io::IoSlice::new(r)).collect();
-            write_all_vectored(&mut w, &mut slices)
-        }
-        #[cfg(not(target_endian = "little"))]
-        {
-            let mut buf = Vec::with_capacity(self.pixels.len() * 12);
-            for row in self.pixels.chunks_exact(width).rev() {
-                for c in row.iter().flat_map(|p| p.to_array()) {
-                    buf.extend_from_slice(&c.to_le_bytes());
-                }
+        w.write_all(pfm_header(self.width, self.height).as_bytes())?;
+        write_pfm_rows(w, &self.pixels, self.width as usize)
+    }
+}
+
+/// The header of a `width`×`height` PFM: its pixel data starts after these bytes.
+pub fn pfm_header(width: u32, height: u32) -> String {
+    format!("PF\n{width} {height}\n-1.0\n")
+}
+
+/// Where the band of `rows` rows from row `y0` down starts in a `width`×`height` PFM's pixel
+/// data (after the header): rows are stored bottom first, so the band's last row comes first.
+pub fn pfm_band_offset(width: u32, height: u32, y0: u32, rows: u32) -> u64 {
+    u64::from(height - y0 - rows) * u64::from(width) * 12
+}
+
+/// Writes `pixels` (whole rows of `width` pixels, top first) as PFM pixel data: the rows in
+/// reverse, bottom first, as the format stores them. On a little-endian CPU a row of `Vec3` is
+/// its PFM bytes, so the rows go out as they lie in memory, in as few vectored writes as the
+/// writer takes: no copy, no per-pixel work.
+pub fn write_pfm_rows(mut w: impl Write, pixels: &[Vec3], width: usize) -> io::Result<()> {
+    if width == 0 {
+        return Ok(());
+    }
+    #[cfg(target_endian = "little")]
+    {
+        let rows: Vec<&[u8]> = pixels.chunks_exact(width).rev().map(bytes).collect();
+        let mut slices: Vec<io::IoSlice> = rows.iter().map(|r| io::IoSlice::new(r)).collect();
+        write_all_vectored(&mut w, &mut slices)
+    }
+    #[cfg(not(target_endian = "little"))]
+    {
+        let mut buf = Vec::with_capacity(pixels.len() * 12);
+        for row in pixels.chunks_exact(width).rev() {
+            for c in row.iter().flat_map(|p| p.to_array()) {
+                buf.extend_from_slice(&c.to_le_bytes());
             }
-            w.write_all(&buf)
         }
+        w.write_all(&buf)
     }
 }
 

@@ -4,6 +4,7 @@
 //! numbers are seeded from (pixel, sample, frame), and the ray counts are integer sums, so the
 //! image and the stats are the same with one thread or many.
 
+use std::sync::{Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
@@ -85,7 +86,38 @@ pub fn render(
     width: u32,
     height: u32,
 ) -> Frame {
-    render_impl(scene, camera, lights, settings, width, height, None, false)
+    render_impl(
+        scene, camera, lights, settings, width, height, None, false, None,
+    )
+}
+
+/// What [`render_streamed`] hands each band of finished rows to: `(y0, pixels)`, the image's
+/// rows from `y0` down, `pixels.len()` a whole number of rows.
+pub type BandDone<'a> = &'a (dyn Fn(u32, &[Vec3]) + Sync);
+
+/// [`render`], handing every row to `done` as soon as it is finished, a band of rows at a time:
+/// on the thread that finished them, in no set order, each row exactly once, all before this
+/// returns. A caller can write the frame out while the rest of it renders.
+pub fn render_streamed(
+    scene: &Scene,
+    camera: &Camera,
+    lights: &[PointLight],
+    settings: &Settings,
+    width: u32,
+    height: u32,
+    done: BandDone,
+) -> Frame {
+    render_impl(
+        scene,
+        camera,
+        lights,
+        settings,
+        width,
+        height,
+        None,
+        false,
+        Some(done),
+    )
 }
 
 /// Renders a frame, reusing `cache`'s primary hits when they are still valid (one sample per
@@ -108,7 +140,14 @@ pub fn render_cached(
         height,
         Some(cache),
         false,
+        None,
     )
+}
+
+/// Whether [`render_denoised`] changes a frame of these settings: only path-traced indirect
+/// light is denoised (other frames come out as [`render`] gives them).
+pub fn denoises(scene: &Scene, lights: &[PointLight], settings: &Settings) -> bool {
+    Tracer::new(scene, lights, *settings).splits()
 }
 
 /// [`render_cached`], and with path-traced indirect light the denoiser's guide buffers too
@@ -131,6 +170,7 @@ pub fn render_guided(
         height,
         Some(cache),
         true,
+        None,
     )
 }
 
@@ -166,6 +206,7 @@ fn render_impl(
     height: u32,
     mut cache: Option<&mut HitCache>,
     guided: bool,
+    done: Option<BandDone>,
 ) -> Frame {
     let start = Instant::now();
     let samples = settings.effects.samples.max(1);
@@ -222,21 +263,29 @@ fn render_impl(
             None => (0..h.div_ceil(TILE)).map(|_| None).collect(),
         };
         // Bands of `TILE` rows, walked in tiles of `TILE`×`TILE` pixels: each tile's camera
-        // rays are traced together (`Scene::intersect_tile`), then shaded pixel by pixel.
-        let counts = image
-            .pixels
-            .par_chunks_mut(TILE * w)
-            .zip(hit_bands.par_iter_mut())
-            .zip(guide_rows.par_chunks_mut(TILE))
-            .enumerate()
-            .map(|(band, ((pixels, hits), guide_rows))| {
-                let mut n = RayCounts::default();
+        // rays are traced together (`Scene::intersect_tile`), then shaded. Every thread takes
+        // the next band until none is left, the calling thread too.
+        let bands = Mutex::new(
+            image
+                .pixels
+                .chunks_mut(TILE * w)
+                .zip(hit_bands.iter_mut())
+                .zip(guide_rows.chunks_mut(TILE))
+                .enumerate(),
+        );
+        let counts = on_every_thread(|| {
+            let mut n = RayCounts::default();
+            let mut tile_rays = RayTile::default();
+            let mut tile_hits = [None; TILE_RAYS];
+            let mut tile_colours = [Vec3::ZERO; TILE_RAYS];
+            let mut scratch = TileScratch::default();
+            let mut tile_cache = TileCache::default();
+            loop {
+                let next = bands.lock().unwrap_or_else(PoisonError::into_inner).next();
+                let Some((band, ((pixels, hits), guide_rows))) = next else {
+                    return n;
+                };
                 let (y0, rows) = (band * TILE, guide_rows.len());
-                let mut tile_rays = RayTile::default();
-                let mut tile_hits = [None; TILE_RAYS];
-                let mut tile_colours = [Vec3::ZERO; TILE_RAYS];
-                let mut scratch = TileScratch::default();
-                let mut tile_cache = TileCache::default();
                 for x0 in (0..w).step_by(TILE) {
                     let cols = (w - x0).min(TILE);
                     // The tile's ray `i`, as an index into the band's rows.
@@ -287,9 +336,11 @@ fn render_impl(
                         pixels[at(i)] = sample(&tracer, ray, tile_hits[i], &mut rng, &mut n, g);
                     }
                 }
-                n
-            })
-            .reduce(RayCounts::default, sum);
+                if let Some(done) = done {
+                    done(y0 as u32, pixels);
+                }
+            }
+        });
         drop(hit_bands);
         if let Some(c) = cache {
             c.key = key;
@@ -336,6 +387,9 @@ fn render_impl(
                         r[x].scale(1.0 / samples as f32);
                     }
                 }
+                if let Some(done) = done {
+                    done(y as u32, row);
+                }
                 n
             })
             .reduce(RayCounts::default, sum)
@@ -349,6 +403,23 @@ fn render_impl(
         },
         guides,
     }
+}
+
+/// Runs `work` on the calling thread and, at the same time, on each other thread of the current
+/// rayon pool, and sums what they return. The calling thread starts at once rather than waking
+/// the pool and waiting for it; a pool thread joins when it wakes (one that wakes after the work
+/// is gone returns at once). `work` shares the work out itself.
+fn on_every_thread(work: impl Fn() -> RayCounts + Sync) -> RayCounts {
+    let helpers = rayon::current_num_threads().saturating_sub(1);
+    let total = Mutex::new(RayCounts::default());
+    let add = |n: RayCounts| *total.lock().unwrap_or_else(PoisonError::into_inner) += n;
+    rayon::in_place_scope(|s| {
+        for _ in 0..helpers {
+            s.spawn(|_| add(work()));
+        }
+        add(work());
+    });
+    total.into_inner().unwrap_or_else(PoisonError::into_inner)
 }
 
 fn sum(mut a: RayCounts, b: RayCounts) -> RayCounts {
@@ -411,7 +482,9 @@ pub fn render_denoised(
     width: u32,
     height: u32,
 ) -> Frame {
-    let mut frame = render_impl(scene, camera, lights, settings, width, height, None, true);
+    let mut frame = render_impl(
+        scene, camera, lights, settings, width, height, None, true, None,
+    );
     if let Some(g) = &frame.guides {
         let start = Instant::now();
         frame.image = denoise(g).image;

@@ -87,6 +87,49 @@ fn images_are_written_to_files() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A PFM file is written band by band while the frame renders: it holds the same bytes as the
+/// PFM on stdout (written after the frame), on 1 and 2 threads, for a frame of one sample
+/// (bands), of several (rows) and a denoised one (written after the frame).
+#[test]
+fn a_pfm_file_holds_the_bytes_stdout_gets() {
+    let dir = std::env::temp_dir().join(format!("raytty-pfm-file-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("f.pfm");
+    for threads in ["1", "2"] {
+        for extra in [
+            &["--stage", "shadows"][..],
+            &["--stage", "gi", "--denoise", "off"],
+            &["--stage", "gi", "--samples", "4"],
+        ] {
+            let run = |output: Option<&std::path::Path>| {
+                let mut cmd = Command::new(env!("CARGO_BIN_EXE_raytty"));
+                cmd.args(["render", "--pixels", "37x21", "--format", "pfm"])
+                    .args(extra)
+                    .env("RAYON_NUM_THREADS", threads);
+                if let Some(path) = output {
+                    cmd.arg("-o").arg(path);
+                }
+                let out = cmd.output().unwrap();
+                assert!(
+                    out.status.success(),
+                    "{}",
+                    String::from_utf8_lossy(&out.stderr)
+                );
+                out.stdout
+            };
+            let stdout = run(None);
+            assert!(stdout.starts_with(b"PF\n37 21\n-1.0\n"));
+            assert!(run(Some(&file)).is_empty());
+            assert_eq!(
+                std::fs::read(&file).unwrap(),
+                stdout,
+                "{threads} threads, {extra:?}"
+            );
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn camera_and_light_flags_change_the_frame() {
     let base = raytty(&["render", "--size", "20x8", "--format", "ascii"]).stdout;

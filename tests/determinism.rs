@@ -3,6 +3,9 @@
 
 use std::process::Command;
 
+use std::sync::Mutex;
+
+use raytty::render::render_streamed;
 use raytty::{Effects, Indirect, Stage, cornell_box, render};
 
 fn image_bytes(threads: usize, stage: Stage, samples: u32) -> Vec<u8> {
@@ -62,6 +65,63 @@ fn path_traced_frames_are_deterministic_across_threads() {
             })
     };
     assert_eq!(run(1), run(2));
+}
+
+/// `render_streamed` hands over every row exactly once, as the frame it returns has it, and that
+/// frame is `render`'s: on 1 and 2 threads, one sample (bands of tiles) and several (rows), at a
+/// size whose last band and last tile column are partial.
+#[test]
+fn streamed_bands_hold_every_row_once_as_the_frame_has_it() {
+    let scene = cornell_box();
+    let (w, h) = (61, 37);
+    for threads in [1, 2] {
+        for (stage, samples) in [(Stage::Shadows, 1), (Stage::Gi, 1), (Stage::Indirect, 4)] {
+            let mut settings = stage.settings(scene.effects());
+            settings.effects.samples = samples;
+            let bands = Mutex::new(Vec::new());
+            let (streamed, plain) = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| {
+                    let done = |y0: u32, rows: &[glam::Vec3]| {
+                        bands.lock().unwrap().push((y0, rows.to_vec()))
+                    };
+                    let streamed = render_streamed(
+                        &scene,
+                        &scene.camera(),
+                        scene.lights(),
+                        &settings,
+                        w,
+                        h,
+                        &done,
+                    );
+                    let plain = render(&scene, &scene.camera(), scene.lights(), &settings, w, h);
+                    (streamed, plain)
+                });
+            let what = format!("{threads} threads, {stage:?}, {samples} spp");
+            assert_eq!(
+                float_bytes(&streamed.image),
+                float_bytes(&plain.image),
+                "{what}"
+            );
+            let mut seen = vec![0; h as usize];
+            for (y0, rows) in bands.into_inner().unwrap() {
+                assert_eq!(rows.len() % w as usize, 0, "{what}");
+                for (dy, row) in rows.chunks(w as usize).enumerate() {
+                    let y = y0 as usize + dy;
+                    seen[y] += 1;
+                    let start = y * w as usize;
+                    assert_eq!(
+                        row,
+                        &streamed.image.pixels[start..start + w as usize],
+                        "{what}, row {y}"
+                    );
+                }
+            }
+            assert!(seen.iter().all(|&n| n == 1), "{what}: rows seen {seen:?}");
+        }
+    }
 }
 
 fn cli_frame(threads: &str, format: &str) -> Vec<u8> {

@@ -3,6 +3,8 @@
 //! input (clap's own usage errors are 2 as well), and for the app 128 + N after signal N
 //! ([`signal_status`]; a dropped terminal counts as SIGHUP).
 
+#[cfg(target_os = "linux")]
+mod alloc;
 mod args;
 mod bench;
 mod progress;

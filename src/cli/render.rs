@@ -1,12 +1,14 @@
 //! `raytty render`: one frame to stdout or a file.
 
 use std::fs::File;
-use std::io::{self, BufWriter, IsTerminal, Seek, Write};
+use std::io::{self, BufWriter, IsTerminal, Seek, SeekFrom, Write};
+use std::sync::{Mutex, PoisonError};
 
 use anyhow::Context;
 use clap::ValueEnum;
 use glam::Vec3;
-use raytty::render::render_denoised;
+use raytty::image::{pfm_band_offset, pfm_header, write_pfm_rows};
+use raytty::render::{denoises, render_denoised, render_streamed};
 use raytty::{CellGrid, ColorMode, PointLight, Scene, encode_text, render};
 
 use raytty::image::MAX_PIXELS;
@@ -125,14 +127,28 @@ pub(super) fn run_render(
         Some(f) => Box::new(BufWriter::new(f)),
         None => Box::new(BufWriter::new(io::stdout().lock())),
     };
-    let frame = if args.denoise == Switch::On {
-        render_denoised(&scene, &camera, &lights, &settings, w, h)
-    } else {
-        render(&scene, &camera, &lights, &settings, w, h)
+    let denoised = args.denoise == Switch::On && denoises(&scene, &lights, &settings);
+    // A PFM file that is not denoised afterwards is written band by band as the render
+    // finishes them, on the render's threads: the write overlaps the rest of the render.
+    let streamed = match &file {
+        Some(f) if format == Format::Pfm && !denoised && f.metadata()?.is_file() => {
+            Some(PfmBands::start(f, w, h).with_context(|| cannot_write(args))?)
+        }
+        _ => None,
+    };
+    let frame = match &streamed {
+        _ if denoised => render_denoised(&scene, &camera, &lights, &settings, w, h),
+        Some(bands) => render_streamed(&scene, &camera, &lights, &settings, w, h, &|y0, rows| {
+            bands.write(y0, rows)
+        }),
+        None => render(&scene, &camera, &lights, &settings, w, h),
     };
     let written = match format {
         Format::Png => frame.image.write_png(&mut out),
-        Format::Pfm => frame.image.write_pfm(&mut out),
+        Format::Pfm => match streamed {
+            Some(bands) => bands.finish(),
+            None => frame.image.write_pfm(&mut out),
+        },
         Format::Ansi | Format::Ansi256 | Format::Ascii => {
             let mode = match format {
                 Format::Ansi => ColorMode::TrueColor,
@@ -151,14 +167,7 @@ pub(super) fn run_render(
                 _ => Ok(()),
             }
         })
-        .with_context(|| {
-            format!(
-                "cannot write to {}",
-                args.output
-                    .as_ref()
-                    .map_or_else(|| "stdout".to_string(), |p| p.display().to_string())
-            )
-        })?;
+        .with_context(|| cannot_write(args))?;
     match args.stats {
         Some(StatsFormat::Text) => {
             eprintln!("raytty: {w}x{h}, {}", frame.stats.summary(scene.isa()))
@@ -167,6 +176,73 @@ pub(super) fn run_render(
         None => {}
     }
     Ok(())
+}
+
+/// "cannot write to FILE" (or stdout).
+fn cannot_write(args: &RenderArgs) -> String {
+    format!(
+        "cannot write to {}",
+        args.output
+            .as_ref()
+            .map_or_else(|| "stdout".to_string(), |p| p.display().to_string())
+    )
+}
+
+/// A PFM file written a band of rows at a time, in any order, as the render hands them over
+/// ([`render_streamed`]): each band goes to its own place (rows are stored bottom first). The
+/// first error stops the writing and is returned by [`PfmBands::finish`].
+struct PfmBands<'f> {
+    /// The file, and the first error writing to it.
+    file: Mutex<(&'f File, Option<io::Error>)>,
+    width: u32,
+    height: u32,
+    header: u64,
+}
+
+impl<'f> PfmBands<'f> {
+    /// Writes the header of a `width`×`height` PFM at the start of `file`.
+    fn start(mut file: &'f File, width: u32, height: u32) -> io::Result<PfmBands<'f>> {
+        let header = pfm_header(width, height);
+        file.seek(SeekFrom::Start(0))?;
+        file.write_all(header.as_bytes())?;
+        Ok(PfmBands {
+            file: Mutex::new((file, None)),
+            width,
+            height,
+            header: header.len() as u64,
+        })
+    }
+
+    /// Writes the rows from `y0` down (whole rows) at their place, unless a write failed.
+    fn write(&self, y0: u32, pixels: &[Vec3]) {
+        let mut file = self.file.lock().unwrap_or_else(PoisonError::into_inner);
+        if file.1.is_some() {
+            return;
+        }
+        let rows = (pixels.len() / self.width as usize) as u32;
+        let at = self.header + pfm_band_offset(self.width, self.height, y0, rows);
+        let mut f = file.0;
+        if let Err(e) = f
+            .seek(SeekFrom::Start(at))
+            .and_then(|_| write_pfm_rows(f, pixels, self.width as usize))
+        {
+            file.1 = Some(e);
+        }
+    }
+
+    /// The first error, if a write failed; else leaves the file's position at the PFM's end,
+    /// where [`run_render`] cuts the file (an older, longer file's tail goes).
+    fn finish(self) -> io::Result<()> {
+        let (mut file, error) = self
+            .file
+            .into_inner()
+            .unwrap_or_else(PoisonError::into_inner);
+        if let Some(e) = error {
+            return Err(e);
+        }
+        let pixels = u64::from(self.width) * u64::from(self.height) * 12;
+        file.seek(SeekFrom::Start(self.header + pixels)).map(|_| ())
+    }
 }
 
 /// Whether stdout was closed when raytty started (`raytty render >&-`), as opposed to a pipe
