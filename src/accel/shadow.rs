@@ -88,6 +88,8 @@ struct Planes4 {
 #[derive(Clone, Copy, Debug)]
 struct CullTri {
     v: [Vec3; 3],
+    /// The vertices as the kernel reads them, `[x, y, z, 0]`.
+    lanes: [[f32; 4]; 3],
     /// Per axis, the least and greatest vertex coordinate.
     min: [f32; 3],
     max: [f32; 3],
@@ -155,7 +157,12 @@ impl ShadowCull {
                     c.hi[k] = c.hi[k].max(v[k] as f64);
                 }
             }
-            c.tris.push(CullTri { v: t.v, min, max });
+            c.tris.push(CullTri {
+                v: t.v,
+                lanes: t.v.map(|v| [v.x, v.y, v.z, 0.0]),
+                min,
+                max,
+            });
         }
         c
     }
@@ -311,7 +318,7 @@ impl ShadowCull {
                 continue;
             }
             // SAFETY: the CPU has AVX2 (this function's contract).
-            let (hit, redo) = unsafe { any_hit8_avx2(&t.v, rays, t_max) };
+            let (hit, redo) = unsafe { any_hit8_avx2(&t.lanes, rays, t_max) };
             blocked |= hit & lanes;
             let mut redo = redo & lanes & !blocked;
             while redo != 0 {

@@ -288,8 +288,14 @@ impl Tracer<'_> {
         // `dist2.max(min_r2)`: dist2 > 0 where it matters, never NaN there.
         let denom = mul(sp(4.0 * PI), _mm256_max_ps(dist2, sp(self.min_r2)));
         let pw = light.power;
-        for (k, c) in [pw.x, pw.y, pw.z].into_iter().enumerate() {
-            st(&mut s.term[k], div(mul(sp(c), cos), denom));
+        let mut term = [div(mul(sp(pw.x), cos), denom); 3];
+        // A white light's three terms are one value (the same operations on the same inputs).
+        if pw.y.to_bits() != pw.x.to_bits() || pw.z.to_bits() != pw.x.to_bits() {
+            term[1] = div(mul(sp(pw.y), cos), denom);
+            term[2] = div(mul(sp(pw.z), cos), denom);
+        }
+        for (k, t) in term.into_iter().enumerate() {
+            st(&mut s.term[k], t);
         }
         // `offset_ray_origin(p, err, normal, to_light)`.
         let d = add(add(mul(abs(nx), ex), mul(abs(ny), ey)), mul(abs(nz), ez));
@@ -416,16 +422,14 @@ fn lane_mask(lanes: u32) -> __m256 {
 fn min_max8(v: __m256, on: __m256) -> (f32, f32) {
     let lo = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), v, on);
     let hi = _mm256_blendv_ps(_mm256_set1_ps(f32::NEG_INFINITY), v, on);
-    let (mut a, mut b) = ([0f32; 8], [0f32; 8]);
-    // SAFETY: writes eight `f32`s.
-    unsafe {
-        _mm256_storeu_ps(a.as_mut_ptr(), lo);
-        _mm256_storeu_ps(b.as_mut_ptr(), hi);
-    }
-    (
-        a.into_iter().fold(f32::INFINITY, f32::min),
-        b.into_iter().fold(f32::NEG_INFINITY, f32::max),
-    )
+    // Halves, then pairs, then neighbours (no lane is NaN: origins are finite).
+    let l = _mm_min_ps(_mm256_castps256_ps128(lo), _mm256_extractf128_ps::<1>(lo));
+    let l = _mm_min_ps(l, _mm_movehl_ps(l, l));
+    let l = _mm_min_ps(l, _mm_shuffle_ps::<1>(l, l));
+    let h = _mm_max_ps(_mm256_castps256_ps128(hi), _mm256_extractf128_ps::<1>(hi));
+    let h = _mm_max_ps(h, _mm_movehl_ps(h, h));
+    let h = _mm_max_ps(h, _mm_shuffle_ps::<1>(h, h));
+    (_mm_cvtss_f32(l), _mm_cvtss_f32(h))
 }
 
 /// The box of the origins of the `traced` lanes (bit per lane, a word per chunk of eight).
