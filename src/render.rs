@@ -288,8 +288,8 @@ fn render_impl(
                 let (y0, rows) = (band * TILE, guide_rows.len());
                 for x0 in (0..w).step_by(TILE) {
                     let cols = (w - x0).min(TILE);
-                    // The tile's ray `i`, as an index into the band's rows.
-                    let at = |i: usize| i / cols * w + x0 + i % cols;
+                    // The tile's row `dy` (`cols` rays from `dy·cols`) in the band's rows.
+                    let row = |dy: usize| dy * w + x0..dy * w + x0 + cols;
                     rays.tile(x0, y0, cols, rows, &mut tile_rays);
                     let k = tile_rays.len();
                     if !reuse {
@@ -301,11 +301,13 @@ fn render_impl(
                             &mut tile_cache,
                         );
                     }
-                    for i in 0..k {
-                        match hits {
-                            Some(h) if reuse => tile_hits[i] = h[at(i)],
-                            Some(h) => h[at(i)] = tile_hits[i],
-                            None => {}
+                    if let Some(h) = hits {
+                        for (dy, tile_row) in tile_hits[..k].chunks_exact_mut(cols).enumerate() {
+                            if reuse {
+                                tile_row.copy_from_slice(&h[row(dy)]);
+                            } else {
+                                h[row(dy)].copy_from_slice(tile_row);
+                            }
                         }
                     }
                     if by_tile {
@@ -317,8 +319,8 @@ fn render_impl(
                             &mut n,
                             &mut scratch,
                         );
-                        for (i, c) in colours.iter().enumerate() {
-                            pixels[at(i)] = *c;
+                        for (dy, tile_row) in colours.chunks_exact(cols).enumerate() {
+                            pixels[row(dy)].copy_from_slice(tile_row);
                         }
                         continue;
                     }
@@ -333,7 +335,8 @@ fn render_impl(
                             Stream::Independent(Rng::seeded(0))
                         };
                         let g = guide_rows[dy].as_mut().map(|r| &mut r[x]);
-                        pixels[at(i)] = sample(&tracer, ray, tile_hits[i], &mut rng, &mut n, g);
+                        pixels[dy * w + x] =
+                            sample(&tracer, ray, tile_hits[i], &mut rng, &mut n, g);
                     }
                 }
                 if let Some(done) = done {
