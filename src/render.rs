@@ -273,7 +273,7 @@ fn render_impl(
                 .zip(guide_rows.chunks_mut(TILE))
                 .enumerate(),
         );
-        let counts = on_every_thread(|| {
+        let counts = on_every_thread(h.div_ceil(TILE), || {
             let mut n = RayCounts::default();
             let mut tile_rays = RayTile::default();
             let mut tile_hits = [None; TILE_RAYS];
@@ -408,12 +408,16 @@ fn render_impl(
     }
 }
 
-/// Runs `work` on the calling thread and, at the same time, on each other thread of the current
-/// rayon pool, and sums what they return. The calling thread starts at once rather than waking
-/// the pool and waiting for it; a pool thread joins when it wakes (one that wakes after the work
-/// is gone returns at once). `work` shares the work out itself.
-fn on_every_thread(work: impl Fn() -> RayCounts + Sync) -> RayCounts {
-    let helpers = rayon::current_num_threads().saturating_sub(1);
+/// Runs `work` on the calling thread and, at the same time, on as many other threads of the
+/// current rayon pool as there are `units` of work left for them, and sums what they return.
+/// The calling thread starts at once rather than waking the pool and waiting for it; a pool
+/// thread joins when it wakes (one that wakes after the work is gone returns at once). `work`
+/// shares the units out itself. With one unit the pool is not used (nor started).
+fn on_every_thread(units: usize, work: impl Fn() -> RayCounts + Sync) -> RayCounts {
+    if units <= 1 {
+        return work();
+    }
+    let helpers = rayon::current_num_threads().min(units) - 1;
     let total = Mutex::new(RayCounts::default());
     let add = |n: RayCounts| *total.lock().unwrap_or_else(PoisonError::into_inner) += n;
     rayon::in_place_scope(|s| {
