@@ -35,7 +35,7 @@ use super::tri4::{Avx2, Sse2};
 use super::tri4::{
     Closest, Kernel, LANES, Portable, RayLanes, Tri4, blocks_closest, blocks_occluded,
 };
-use crate::geometry::{Ray, Triangle};
+use crate::geometry::{Ray, RayTile, Triangle};
 use node::{Node, NodePair};
 use wide::{LEAF, TreeStats, WIDTH, Wide, WideBoxes, leaf_blocks};
 
@@ -174,6 +174,59 @@ impl Bvh {
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => self.any::<Sse2>(ray, t_max),
             _ => self.any::<Portable>(ray, t_max),
+        }
+    }
+
+    /// [`Bvh::intersect_isa`] for each of `tile`'s rays, into `hits` (as many): the path picked
+    /// once for them all. `isa` must be available.
+    pub(super) fn intersect_tile(
+        &self,
+        isa: Isa,
+        tile: &RayTile,
+        t_max: f32,
+        hits: &mut [Option<Hit>],
+    ) {
+        debug_assert!(isa.available(), "{} is not available", isa.name());
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the caller passes an available path.
+            Isa::Avx2 => unsafe { closest_each_avx2(self, tile, t_max, hits) },
+            #[cfg(target_arch = "x86_64")]
+            Isa::Sse2 => self.closest_each::<Sse2>(tile, t_max, hits),
+            _ => self.closest_each::<Portable>(tile, t_max, hits),
+        }
+    }
+
+    /// [`Bvh::occluded_isa`] for each of `rays`, into `out` (as many): the path picked once
+    /// for them all. `isa` must be available.
+    pub(super) fn occluded_each(&self, isa: Isa, rays: &[Ray], t_max: f32, out: &mut [bool]) {
+        debug_assert!(isa.available(), "{} is not available", isa.name());
+        match isa {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the caller passes an available path.
+            Isa::Avx2 => unsafe { any_each_avx2(self, rays, t_max, out) },
+            #[cfg(target_arch = "x86_64")]
+            Isa::Sse2 => self.any_each::<Sse2>(rays, t_max, out),
+            _ => self.any_each::<Portable>(rays, t_max, out),
+        }
+    }
+
+    #[inline(always)]
+    fn closest_each<K: Kernel + WideBoxes>(
+        &self,
+        tile: &RayTile,
+        t_max: f32,
+        hits: &mut [Option<Hit>],
+    ) {
+        for (i, h) in hits.iter_mut().enumerate() {
+            *h = self.closest::<K>(&tile.ray(i), t_max);
+        }
+    }
+
+    #[inline(always)]
+    fn any_each<K: Kernel + WideBoxes>(&self, rays: &[Ray], t_max: f32, out: &mut [bool]) {
+        for (o, r) in out.iter_mut().zip(rays) {
+            *o = self.any::<K>(r, t_max);
         }
     }
 
@@ -322,6 +375,18 @@ fn prefetch<T>(p: *const T) {
 #[target_feature(enable = "avx2")]
 unsafe fn closest_avx2(bvh: &Bvh, ray: &Ray, t_max: f32) -> Option<Hit> {
     bvh.closest::<Avx2>(ray, t_max)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn closest_each_avx2(bvh: &Bvh, tile: &RayTile, t_max: f32, hits: &mut [Option<Hit>]) {
+    bvh.closest_each::<Avx2>(tile, t_max, hits);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn any_each_avx2(bvh: &Bvh, rays: &[Ray], t_max: f32, out: &mut [bool]) {
+    bvh.any_each::<Avx2>(rays, t_max, out);
 }
 
 #[cfg(target_arch = "x86_64")]

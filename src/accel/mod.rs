@@ -200,11 +200,7 @@ impl Accel {
     ) {
         match &self.structure {
             Structure::Flat(flat) => flat.intersect_tile(self.isa, tile, t_max, hits, cache),
-            Structure::Bvh(bvh) => {
-                for (i, h) in hits.iter_mut().enumerate() {
-                    *h = bvh.intersect(&tile.ray(i), t_max);
-                }
-            }
+            Structure::Bvh(bvh) => bvh.intersect_tile(self.isa, tile, t_max, hits),
         }
     }
 
@@ -212,11 +208,7 @@ impl Accel {
     pub fn occluded_each(&self, rays: &[Ray], t_max: f32, out: &mut [bool]) {
         match &self.structure {
             Structure::Flat(flat) => flat.occluded_each(self.isa, rays, t_max, out),
-            Structure::Bvh(_) => {
-                for (o, r) in out.iter_mut().zip(rays) {
-                    *o = self.occluded(r, t_max);
-                }
-            }
+            Structure::Bvh(bvh) => bvh.occluded_each(self.isa, rays, t_max, out),
         }
     }
 

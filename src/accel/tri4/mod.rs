@@ -156,24 +156,33 @@ impl Hits {
         b: [[0.0; 2 * LANES]; 3],
     };
 
-    /// `a`'s lanes, then `b`'s as lanes 4-7.
-    #[inline(always)]
-    fn join(a: Hits, b: Hits) -> Hits {
-        if (a.mask | b.mask) == 0 {
-            return Hits {
-                redo: a.redo | b.redo << LANES,
-                ..Hits::NONE
-            };
+    /// The masks a kernel returned and the lanes it wrote.
+    fn of((mask, redo): (u32, u32), lanes: &LaneHits) -> Hits {
+        Hits {
+            mask,
+            redo,
+            t: lanes.t,
+            b: lanes.b,
         }
-        let mut out = a;
-        out.mask |= b.mask << LANES;
-        out.redo |= b.redo << LANES;
-        out.t[LANES..].copy_from_slice(&b.t[..LANES]);
-        for (o, i) in out.b.iter_mut().zip(&b.b) {
-            o[LANES..].copy_from_slice(&i[..LANES]);
-        }
-        out
     }
+}
+
+/// Where a kernel writes its hit lanes' `t` and barycentrics (lanes 4-7 from a second block):
+/// written only when some lane is hit, meaningful only in hit lanes. The masks themselves
+/// are returned (in registers), so that a traversal that inlines the kernel tests them
+/// without a round trip through memory, and an any-hit query never reads this at all.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LaneHits {
+    pub t: [f32; 2 * LANES],
+    pub b: [[f32; 2 * LANES]; 3],
+}
+
+impl LaneHits {
+    /// Nothing written yet.
+    pub const ZERO: LaneHits = LaneHits {
+        t: [0.0; 2 * LANES],
+        b: [[0.0; 2 * LANES]; 3],
+    };
 }
 
 /// Each of eight rays' closest hit so far: `t` (∞ for none yet), barycentrics and triangle.
@@ -219,10 +228,18 @@ impl Best8 {
 
 /// How a traversal tests blocks: one of the three paths, chosen by the type.
 pub(crate) trait Kernel {
-    /// The hits in one block.
-    fn one(block: &Tri4, ray: &Ray, r: &RayLanes, t_max: f32) -> Hits;
-    /// The hits in two blocks (lanes 4-7 from `b`).
-    fn two(a: &Tri4, b: &Tri4, ray: &Ray, r: &RayLanes, t_max: f32) -> Hits;
+    /// The hits in one block: `(mask, redo)` as in [`Hits`]; the hit lanes' `t` and
+    /// barycentrics into `out` (lanes 0-3).
+    fn one(block: &Tri4, ray: &Ray, r: &RayLanes, t_max: f32, out: &mut LaneHits) -> (u32, u32);
+    /// The hits in two blocks (lanes 4-7 from `b`), as [`Kernel::one`].
+    fn two(
+        a: &Tri4,
+        b: &Tri4,
+        ray: &Ray,
+        r: &RayLanes,
+        t_max: f32,
+        out: &mut LaneHits,
+    ) -> (u32, u32);
     /// Which of four boxes the ray meets before `t_max`, and where it enters them.
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]);
     /// Triangle `id` (vertices `v`; `rel` relative to the rays' common origin in their axis
@@ -245,12 +262,21 @@ pub(crate) struct Portable;
 
 impl Kernel for Portable {
     #[inline(always)]
-    fn one(block: &Tri4, ray: &Ray, _: &RayLanes, t_max: f32) -> Hits {
-        portable::hits(block, ray, t_max)
+    fn one(block: &Tri4, ray: &Ray, _: &RayLanes, t_max: f32, out: &mut LaneHits) -> (u32, u32) {
+        portable::hits(block, ray, t_max, out, 0)
     }
     #[inline(always)]
-    fn two(a: &Tri4, b: &Tri4, ray: &Ray, _: &RayLanes, t_max: f32) -> Hits {
-        Hits::join(portable::hits(a, ray, t_max), portable::hits(b, ray, t_max))
+    fn two(
+        a: &Tri4,
+        b: &Tri4,
+        ray: &Ray,
+        _: &RayLanes,
+        t_max: f32,
+        out: &mut LaneHits,
+    ) -> (u32, u32) {
+        let (m0, r0) = portable::hits(a, ray, t_max, out, 0);
+        let (m1, r1) = portable::hits(b, ray, t_max, out, LANES);
+        (m0 | m1 << LANES, r0 | r1 << LANES)
     }
     #[inline(always)]
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
@@ -281,12 +307,21 @@ pub(crate) struct Sse2;
 #[cfg(target_arch = "x86_64")]
 impl Kernel for Sse2 {
     #[inline(always)]
-    fn one(block: &Tri4, _: &Ray, r: &RayLanes, t_max: f32) -> Hits {
-        x86::hits_sse2(block, r, t_max)
+    fn one(block: &Tri4, _: &Ray, r: &RayLanes, t_max: f32, out: &mut LaneHits) -> (u32, u32) {
+        x86::hits_sse2(block, r, t_max, out, 0)
     }
     #[inline(always)]
-    fn two(a: &Tri4, b: &Tri4, _: &Ray, r: &RayLanes, t_max: f32) -> Hits {
-        Hits::join(x86::hits_sse2(a, r, t_max), x86::hits_sse2(b, r, t_max))
+    fn two(
+        a: &Tri4,
+        b: &Tri4,
+        _: &Ray,
+        r: &RayLanes,
+        t_max: f32,
+        out: &mut LaneHits,
+    ) -> (u32, u32) {
+        let (m0, r0) = x86::hits_sse2(a, r, t_max, out, 0);
+        let (m1, r1) = x86::hits_sse2(b, r, t_max, out, LANES);
+        (m0 | m1 << LANES, r0 | r1 << LANES)
     }
     #[inline(always)]
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
@@ -313,14 +348,22 @@ pub(crate) struct Avx2;
 #[cfg(target_arch = "x86_64")]
 impl Kernel for Avx2 {
     #[inline(always)]
-    fn one(block: &Tri4, _: &Ray, r: &RayLanes, t_max: f32) -> Hits {
-        // SAFETY: `Avx2` is only instantiated behind a check that the CPU has AVX2.
-        unsafe { x86::hits_avx2(block, r, t_max) }
+    fn one(block: &Tri4, _: &Ray, r: &RayLanes, t_max: f32, out: &mut LaneHits) -> (u32, u32) {
+        // The SSE2 kernel, VEX-encoded where it inlines (functions compiled for AVX2).
+        x86::hits_sse2(block, r, t_max, out, 0)
     }
     #[inline(always)]
-    fn two(a: &Tri4, b: &Tri4, _: &Ray, r: &RayLanes, t_max: f32) -> Hits {
-        // SAFETY: as above.
-        unsafe { x86::hits2_avx2(a, b, r, t_max) }
+    fn two(
+        a: &Tri4,
+        b: &Tri4,
+        _: &Ray,
+        r: &RayLanes,
+        t_max: f32,
+        out: &mut LaneHits,
+    ) -> (u32, u32) {
+        // SAFETY: `Avx2` is only instantiated behind a check that the CPU has AVX2, inside
+        // functions compiled for it (so the kernel inlines).
+        unsafe { x86::hits2_avx2(a, b, r, t_max, out) }
     }
     #[inline(always)]
     fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
@@ -349,16 +392,18 @@ pub fn hits(isa: Isa, block: &Tri4, ray: &Ray, t_max: f32) -> Hits {
         isa.name()
     );
     let r = RayLanes::new(ray);
-    match isa {
-        Isa::Portable => Portable::one(block, ray, &r, t_max),
+    let mut out = LaneHits::ZERO;
+    let masks = match isa {
+        Isa::Portable => Portable::one(block, ray, &r, t_max, &mut out),
         #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 => Sse2::one(block, ray, &r, t_max),
+        Isa::Sse2 => Sse2::one(block, ray, &r, t_max, &mut out),
         #[cfg(target_arch = "x86_64")]
         // SAFETY: checked available above.
-        Isa::Avx2 => unsafe { x86::hits_avx2(block, &r, t_max) },
+        Isa::Avx2 => unsafe { x86::hits_avx2_call(block, &r, t_max, &mut out) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => unreachable!(),
-    }
+    };
+    Hits::of(masks, &out)
 }
 
 /// The hits of `ray` in two blocks on path `isa` (lanes 4-7 from `b`). `isa` must be available.
@@ -369,14 +414,16 @@ pub fn hits2(isa: Isa, a: &Tri4, b: &Tri4, ray: &Ray, t_max: f32) -> Hits {
         isa.name()
     );
     let r = RayLanes::new(ray);
-    match isa {
-        Isa::Portable => Portable::two(a, b, ray, &r, t_max),
+    let mut out = LaneHits::ZERO;
+    let masks = match isa {
+        Isa::Portable => Portable::two(a, b, ray, &r, t_max, &mut out),
         #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 => Sse2::two(a, b, ray, &r, t_max),
+        Isa::Sse2 => Sse2::two(a, b, ray, &r, t_max, &mut out),
         #[cfg(target_arch = "x86_64")]
         // SAFETY: checked available above.
-        Isa::Avx2 => unsafe { x86::hits2_avx2(a, b, &r, t_max) },
+        Isa::Avx2 => unsafe { x86::hits2_avx2_call(a, b, &r, t_max, &mut out) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => unreachable!(),
-    }
+    };
+    Hits::of(masks, &out)
 }

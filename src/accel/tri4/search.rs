@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use super::{Hits, Kernel, LANES, RayLanes, Tri4};
+use super::{Kernel, LANES, LaneHits, RayLanes, Tri4};
 use crate::accel::hit::{Hit, shrunk_t_max};
 use crate::geometry::{Ray, intersect_watertight};
 
@@ -39,23 +39,25 @@ impl Closest {
         }
     }
 
-    /// Folds a kernel's hits into the best: its hit lanes as they are, its `redo` lanes through
-    /// the scalar test. `vertices(lane)` and `id(lane)` give a lane's triangle.
+    /// Folds a kernel's hits into the best: its hit lanes (`mask`, values in `h`) as they are,
+    /// its `redo` lanes through the scalar test. `vertices(lane)` and `id(lane)` give a lane's
+    /// triangle.
     #[inline(always)]
     pub fn take(
         &mut self,
         ray: &Ray,
-        h: &Hits,
+        (mask, redo): (u32, u32),
+        h: &LaneHits,
         vertices: impl Fn(usize) -> [Vec3; 3],
         id: impl Fn(usize) -> u32,
     ) {
-        let mut m = h.mask;
+        let mut m = mask;
         while m != 0 {
             let l = m.trailing_zeros() as usize;
             m &= m - 1;
             self.offer(h.t[l], [h.b[0][l], h.b[1][l], h.b[2][l]], id(l));
         }
-        let mut m = h.redo;
+        let mut m = redo;
         while m != 0 {
             let l = m.trailing_zeros() as usize;
             m &= m - 1;
@@ -76,16 +78,21 @@ pub(crate) fn blocks_closest<K: Kernel>(
     r: &RayLanes,
     c: &mut Closest,
 ) {
+    let mut h = LaneHits::ZERO;
     let mut b = 0;
     while b < blocks.len() {
-        let (h, n) = if b + 1 < blocks.len() {
-            (K::two(&blocks[b], &blocks[b + 1], ray, r, c.tri_t_max), 2)
+        let (masks, n) = if b + 1 < blocks.len() {
+            (
+                K::two(&blocks[b], &blocks[b + 1], ray, r, c.tri_t_max, &mut h),
+                2,
+            )
         } else {
-            (K::one(&blocks[b], ray, r, c.tri_t_max), 1)
+            (K::one(&blocks[b], ray, r, c.tri_t_max, &mut h), 1)
         };
-        if (h.mask | h.redo) != 0 {
+        if (masks.0 | masks.1) != 0 {
             c.take(
                 ray,
+                masks,
                 &h,
                 |l| blocks[b + l / LANES].vertices(l % LANES),
                 |l| ids[b * LANES + l],
@@ -103,17 +110,23 @@ pub(crate) fn blocks_occluded<K: Kernel>(
     r: &RayLanes,
     t_max: f32,
 ) -> bool {
+    // Written by the kernels, never read: an any-hit query needs only the masks (where the
+    // kernels inline, the stores and the barycentrics they would need are dropped).
+    let mut unused = LaneHits::ZERO;
     let mut b = 0;
     while b < blocks.len() {
-        let (h, n) = if b + 1 < blocks.len() {
-            (K::two(&blocks[b], &blocks[b + 1], ray, r, t_max), 2)
+        let ((mask, redo), n) = if b + 1 < blocks.len() {
+            (
+                K::two(&blocks[b], &blocks[b + 1], ray, r, t_max, &mut unused),
+                2,
+            )
         } else {
-            (K::one(&blocks[b], ray, r, t_max), 1)
+            (K::one(&blocks[b], ray, r, t_max, &mut unused), 1)
         };
-        if h.mask != 0 {
+        if mask != 0 {
             return true;
         }
-        let mut m = h.redo;
+        let mut m = redo;
         while m != 0 {
             let l = m.trailing_zeros() as usize;
             m &= m - 1;

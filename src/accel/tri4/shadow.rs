@@ -38,7 +38,11 @@ pub unsafe fn any_hit8_avx2(v: &[Vec3; 3], rays: &ShadowRays8, t_max: f32) -> (u
     // SAFETY: every load reads a whole 32-byte-aligned `[f32; 8]`.
     let load = |p: &[f32; 8]| unsafe { _mm256_load_ps(p.as_ptr()) };
     let [kx, ky, kz] = rays.axes;
-    let [ox, oy, oz] = rays.origin.each_ref().map(load);
+    let (ox, oy, oz) = (
+        load(&rays.origin[0]),
+        load(&rays.origin[1]),
+        load(&rays.origin[2]),
+    );
     // `RayFrame`: each vertex relative to each lane's origin, in the axis order.
     let rel = |p: Vec3| {
         (
@@ -48,7 +52,11 @@ pub unsafe fn any_hit8_avx2(v: &[Vec3; 3], rays: &ShadowRays8, t_max: f32) -> (u
         )
     };
     let ((a0, b0, z0), (a1, b1, z1), (a2, b2, z2)) = (rel(v[0]), rel(v[1]), rel(v[2]));
-    let [sx, sy, sz] = rays.shear.each_ref().map(load);
+    let (sx, sy, sz) = (
+        load(&rays.shear[0]),
+        load(&rays.shear[1]),
+        load(&rays.shear[2]),
+    );
     let (hit, redo, ..) = watertight_lanes!(
         avx,
         [a0, b0, z0, a1, b1, z1, a2, b2, z2],

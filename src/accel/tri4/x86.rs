@@ -10,7 +10,7 @@
 
 use std::arch::x86_64::*;
 
-use super::{Best8, Hits, LANES, RayLanes, Tri4};
+use super::{Best8, LANES, LaneHits, RayLanes, Tri4};
 use crate::geometry::{RayTile, gamma};
 
 /// The watertight test of one ray against every lane of `$load`'s triangles, with the
@@ -345,34 +345,52 @@ pub(super) mod avx {
     }
 }
 
-/// The hits of one block with SSE2 (four lanes).
+/// The hits of one block with SSE2 (four lanes): `(mask, redo)` as in [`super::Hits`], and, when
+/// some lane is hit, their `t` and barycentrics into lanes `half..half + 4` of `out`.
 #[inline(always)]
-pub fn hits_sse2(block: &Tri4, r: &RayLanes, t_max: f32) -> Hits {
+pub fn hits_sse2(
+    block: &Tri4,
+    r: &RayLanes,
+    t_max: f32,
+    out: &mut LaneHits,
+    half: usize,
+) -> (u32, u32) {
     let v = &block.v;
     // SAFETY: SSE2 is part of every x86-64; each load reads a whole aligned `[f32; 4]`.
     let load = |i: usize, axis: usize| unsafe { _mm_load_ps(v[i][axis].as_ptr()) };
     let (mask, redo, t, b0, b1, b2, _) = triangle_lanes!(sse, load, r, t_max);
-    let mut out = Hits { redo, ..Hits::NONE };
     if mask != 0 {
-        out.mask = mask;
-        // SAFETY: each store writes the first four of eight `f32`s.
+        // SAFETY: each store writes four of eight `f32`s (`half` is 0 or 4).
         unsafe {
-            _mm_storeu_ps(out.t.as_mut_ptr(), t);
-            _mm_storeu_ps(out.b[0].as_mut_ptr(), b0);
-            _mm_storeu_ps(out.b[1].as_mut_ptr(), b1);
-            _mm_storeu_ps(out.b[2].as_mut_ptr(), b2);
+            _mm_storeu_ps(out.t[half..].as_mut_ptr(), t);
+            _mm_storeu_ps(out.b[0][half..].as_mut_ptr(), b0);
+            _mm_storeu_ps(out.b[1][half..].as_mut_ptr(), b1);
+            _mm_storeu_ps(out.b[2][half..].as_mut_ptr(), b2);
         }
     }
-    out
+    (mask, redo)
 }
 
-/// The hits of two blocks at once with AVX2: lanes 0-3 from `a`, 4-7 from `b`.
+/// The hits of two blocks at once with AVX2 (lanes 0-3 from `a`, 4-7 from `b`): `(mask,
+/// redo)` as in [`super::Hits`], and, when some lane is hit, their `t` and barycentrics into `out`.
+///
+/// Always inlined, and without a `target_feature` of its own (a function with one cannot be
+/// `inline(always)`, and LLVM declines to inline one this large): it is only called from
+/// functions compiled with AVX2 enabled, where its operations (AVX2 functions themselves,
+/// which do inline there) become the caller's own instructions, the masks stay in registers
+/// and a caller that reads only the masks (an any-hit query) drops the rest. Called from
+/// anywhere else it would still be right, only slow.
 ///
 /// # Safety
 /// The CPU must have AVX2 ([`super::Isa::Avx2`] available).
-#[target_feature(enable = "avx2")]
-#[inline]
-pub unsafe fn hits2_avx2(a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Hits {
+#[inline(always)]
+pub unsafe fn hits2_avx2(
+    a: &Tri4,
+    b: &Tri4,
+    r: &RayLanes,
+    t_max: f32,
+    out: &mut LaneHits,
+) -> (u32, u32) {
     #[target_feature(enable = "avx2")]
     #[inline]
     fn load2(a: &Tri4, b: &Tri4, i: usize, axis: usize) -> __m256 {
@@ -385,30 +403,51 @@ pub unsafe fn hits2_avx2(a: &Tri4, b: &Tri4, r: &RayLanes, t_max: f32) -> Hits {
             )
         }
     }
-    let load = |i: usize, axis: usize| load2(a, b, i, axis);
-    let (mask, redo, t, b0, b1, b2, _) = triangle_lanes!(avx, load, r, t_max);
-    let mut out = Hits { redo, ..Hits::NONE };
-    if mask != 0 {
-        out.mask = mask;
-        // SAFETY: each store writes eight `f32`s.
-        unsafe {
+    // SAFETY: the caller guarantees AVX2, which every operation here needs and no more.
+    unsafe {
+        let load = |i: usize, axis: usize| load2(a, b, i, axis);
+        let (mask, redo, t, b0, b1, b2, _) = triangle_lanes!(avx, load, r, t_max);
+        if mask != 0 {
+            // Each store writes eight `f32`s.
             _mm256_storeu_ps(out.t.as_mut_ptr(), t);
             _mm256_storeu_ps(out.b[0].as_mut_ptr(), b0);
             _mm256_storeu_ps(out.b[1].as_mut_ptr(), b1);
             _mm256_storeu_ps(out.b[2].as_mut_ptr(), b2);
         }
+        (mask, redo)
     }
-    out
 }
 
-/// One block on the AVX2 path: the SSE2 kernel (VEX-encoded in this context).
+/// [`hits2_avx2`] compiled as a function of its own with AVX2 (for [`super::hits2`]: tests
+/// and tools).
 ///
 /// # Safety
 /// The CPU must have AVX2.
 #[target_feature(enable = "avx2")]
-#[inline]
-pub unsafe fn hits_avx2(block: &Tri4, r: &RayLanes, t_max: f32) -> Hits {
-    hits_sse2(block, r, t_max)
+pub unsafe fn hits2_avx2_call(
+    a: &Tri4,
+    b: &Tri4,
+    r: &RayLanes,
+    t_max: f32,
+    out: &mut LaneHits,
+) -> (u32, u32) {
+    // SAFETY: as the caller guarantees.
+    unsafe { hits2_avx2(a, b, r, t_max, out) }
+}
+
+/// [`hits_sse2`] compiled with AVX2 (VEX-encoded): the one-block kernel of the AVX2 path, as
+/// traversals inline it (for [`super::hits`]: tests and tools).
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[target_feature(enable = "avx2")]
+pub unsafe fn hits_avx2_call(
+    block: &Tri4,
+    r: &RayLanes,
+    t_max: f32,
+    out: &mut LaneHits,
+) -> (u32, u32) {
+    hits_sse2(block, r, t_max, out, 0)
 }
 
 const _: () = assert!(LANES == 4);
