@@ -324,7 +324,7 @@ fn render_impl(
                         }
                         continue;
                     }
-                    for i in 0..k {
+                    for (i, &hit) in tile_hits[..k].iter().enumerate() {
                         let ray = &tile_rays.ray(i);
                         let (dy, x) = (i / cols, x0 + i % cols);
                         let y = y0 + dy;
@@ -335,8 +335,7 @@ fn render_impl(
                             Stream::Independent(Rng::seeded(0))
                         };
                         let g = guide_rows[dy].as_mut().map(|r| &mut r[x]);
-                        pixels[dy * w + x] =
-                            sample(&tracer, ray, tile_hits[i], &mut rng, &mut n, g);
+                        pixels[dy * w + x] = sample(&tracer, ray, hit, &mut rng, &mut n, g);
                     }
                 }
                 if let Some(done) = done {
