@@ -273,7 +273,7 @@ fn render_impl(
                 .zip(guide_rows.chunks_mut(TILE))
                 .enumerate(),
         );
-        let counts = on_every_thread(|| {
+        let counts = on_every_thread(h.div_ceil(TILE), || {
             let mut n = RayCounts::default();
             let mut tile_rays = RayTile::default();
             let mut tile_hits = [None; TILE_RAYS];
@@ -288,8 +288,8 @@ fn render_impl(
                 let (y0, rows) = (band * TILE, guide_rows.len());
                 for x0 in (0..w).step_by(TILE) {
                     let cols = (w - x0).min(TILE);
-                    // The tile's ray `i`, as an index into the band's rows.
-                    let at = |i: usize| i / cols * w + x0 + i % cols;
+                    // The tile's row `dy` (`cols` rays from `dy·cols`) in the band's rows.
+                    let row = |dy: usize| dy * w + x0..dy * w + x0 + cols;
                     rays.tile(x0, y0, cols, rows, &mut tile_rays);
                     let k = tile_rays.len();
                     if !reuse {
@@ -301,11 +301,13 @@ fn render_impl(
                             &mut tile_cache,
                         );
                     }
-                    for i in 0..k {
-                        match hits {
-                            Some(h) if reuse => tile_hits[i] = h[at(i)],
-                            Some(h) => h[at(i)] = tile_hits[i],
-                            None => {}
+                    if let Some(h) = hits {
+                        for (dy, tile_row) in tile_hits[..k].chunks_exact_mut(cols).enumerate() {
+                            if reuse {
+                                tile_row.copy_from_slice(&h[row(dy)]);
+                            } else {
+                                h[row(dy)].copy_from_slice(tile_row);
+                            }
                         }
                     }
                     if by_tile {
@@ -317,12 +319,12 @@ fn render_impl(
                             &mut n,
                             &mut scratch,
                         );
-                        for (i, c) in colours.iter().enumerate() {
-                            pixels[at(i)] = *c;
+                        for (dy, tile_row) in colours.chunks_exact(cols).enumerate() {
+                            pixels[row(dy)].copy_from_slice(tile_row);
                         }
                         continue;
                     }
-                    for i in 0..k {
+                    for (i, &hit) in tile_hits[..k].iter().enumerate() {
                         let ray = &tile_rays.ray(i);
                         let (dy, x) = (i / cols, x0 + i % cols);
                         let y = y0 + dy;
@@ -333,7 +335,7 @@ fn render_impl(
                             Stream::Independent(Rng::seeded(0))
                         };
                         let g = guide_rows[dy].as_mut().map(|r| &mut r[x]);
-                        pixels[at(i)] = sample(&tracer, ray, tile_hits[i], &mut rng, &mut n, g);
+                        pixels[dy * w + x] = sample(&tracer, ray, hit, &mut rng, &mut n, g);
                     }
                 }
                 if let Some(done) = done {
@@ -405,12 +407,16 @@ fn render_impl(
     }
 }
 
-/// Runs `work` on the calling thread and, at the same time, on each other thread of the current
-/// rayon pool, and sums what they return. The calling thread starts at once rather than waking
-/// the pool and waiting for it; a pool thread joins when it wakes (one that wakes after the work
-/// is gone returns at once). `work` shares the work out itself.
-fn on_every_thread(work: impl Fn() -> RayCounts + Sync) -> RayCounts {
-    let helpers = rayon::current_num_threads().saturating_sub(1);
+/// Runs `work` on the calling thread and, at the same time, on as many other threads of the
+/// current rayon pool as there are `units` of work left for them, and sums what they return.
+/// The calling thread starts at once rather than waking the pool and waiting for it; a pool
+/// thread joins when it wakes (one that wakes after the work is gone returns at once). `work`
+/// shares the units out itself. With one unit the pool is not used (nor started).
+fn on_every_thread(units: usize, work: impl Fn() -> RayCounts + Sync) -> RayCounts {
+    if units <= 1 {
+        return work();
+    }
+    let helpers = rayon::current_num_threads().min(units) - 1;
     let total = Mutex::new(RayCounts::default());
     let add = |n: RayCounts| *total.lock().unwrap_or_else(PoisonError::into_inner) += n;
     rayon::in_place_scope(|s| {

@@ -18,7 +18,7 @@
 //! common to all three edges. With `d` replaced by `L − o` it is
 //! `Fᵢ(o)/|d_kz|`, `Fᵢ(o) = nᵢ·(L − o)`, `nᵢ = (vⱼ − L) × (vₖ − L)`: the side of `o` of the
 //! plane through the light and edge `jk` (the triangle's shadow frustum), affine in `o`. So
-//! over the box `B` of a tile's origins each `Fᵢ`, and each sum `Fⱼ + Fₖ`, lies within
+//! over the box `B` of a tile's origins each `Fᵢ` lies within
 //! `nᵢ·(L − c) ± |nᵢ|·h` (centre `c`, half extent `h`).
 //!
 //! The scalar test's `eᵢ` (in `f32`, or redone in `f64`) is within `EdgeErrors`' bound of the
@@ -33,8 +33,9 @@
 //! `M = D·δe + 6R²(εD + tiny) + 2⁻⁴⁰·(magnitudes)`, `Fᵢ < −M` over `B` means the scalar test's
 //! `eᵢ` has the sign of `−1` (times the common sign) for every ray of the tile, `Fᵢ > M` the
 //! other. A triangle is dropped when for every ray some edge is certainly negative and some
-//! certainly positive: some `Fᵢ < −M` and some `Fⱼ > M` over `B`, or some `Fᵢ < −M` and
-//! `Fⱼ + Fₖ > 2M` (then one of the two exceeds `M`), or the same with signs swapped. Mixed
+//! certainly positive: some `Fᵢ < −M` and some `Fⱼ > M` over `B` (so that no ray's three signs
+//! agree, whatever `det`'s sign; the sums `Fⱼ + Fₖ = N·(L − o) − Fᵢ` would add a few cases,
+//! about 2 % of the kept triangles in the seed frame, not worth their cost). Mixed
 //! signs are rejected by the scalar test whatever else holds. A margin or bound that is not
 //! finite compares false: the triangle is kept.
 //!
@@ -74,20 +75,21 @@ pub struct ShadowCull {
     tris: Vec<CullTri>,
 }
 
-/// Four triangles' planes through the light: per plane (edges 0-2, then for 3-5 the sum of
-/// the other two edges' planes), per axis, per triangle: the normal `nᵢ = (vⱼ − L) × (vₖ − L)`
+/// Four triangles' planes through the light: per edge, per axis, per triangle: the normal `nᵢ = (vⱼ − L) × (vₖ − L)`
 /// and its magnitude. Lanes without a triangle are zero (never culled).
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(C, align(32))]
 struct Planes4 {
-    n: [[[f64; 4]; 3]; 6],
-    abs: [[[f64; 4]; 3]; 6],
+    n: [[[f64; 4]; 3]; 3],
+    abs: [[[f64; 4]; 3]; 3],
 }
 
 /// One triangle as the rays see it.
 #[derive(Clone, Copy, Debug)]
 struct CullTri {
     v: [Vec3; 3],
+    /// The vertices as the kernel reads them, `[x, y, z, 0]`.
+    lanes: [[f32; 4]; 3],
     /// Per axis, the least and greatest vertex coordinate.
     min: [f32; 3],
     max: [f32; 3],
@@ -138,12 +140,9 @@ impl ShadowCull {
             let n = edges.map(|(j, k)| cross(w[j], w[k]));
             let (g, lane) = (&mut c.groups[i / 4], i % 4);
             for e in 0..3 {
-                let (j, k) = ((e + 1) % 3, (e + 2) % 3);
                 for a in 0..3 {
                     g.n[e][a][lane] = n[e][a];
-                    g.n[3 + e][a][lane] = n[j][a] + n[k][a];
                     g.abs[e][a][lane] = n[e][a].abs();
-                    g.abs[3 + e][a][lane] = (n[j][a] + n[k][a]).abs();
                 }
                 for g in abs_cross(w[edges[e].0], w[edges[e].1]) {
                     c.mag = c.mag.max(g);
@@ -158,7 +157,12 @@ impl ShadowCull {
                     c.hi[k] = c.hi[k].max(v[k] as f64);
                 }
             }
-            c.tris.push(CullTri { v: t.v, min, max });
+            c.tris.push(CullTri {
+                v: t.v,
+                lanes: t.v.map(|v| [v.x, v.y, v.z, 0.0]),
+                min,
+                max,
+            });
         }
         c
     }
@@ -201,23 +205,23 @@ impl ShadowCull {
         let dx = g5 * (x + 2.0 * SHEAR * r) + 2.0 * TINY;
         let de = 4.0 * (4.0 * x * dx + g2 * 2.0 * x * x) + 4.0 * TINY;
         let eps = f32::EPSILON as f64 * 0.5;
-        // The margin of one edge; a sum of two edges gets twice it.
+        // The margin of one edge.
         let m = scale * (d * de + 6.0 * r * r * (eps * d + TINY) + RHO * self.mag * um);
-        let mut neg = [0u64; 6];
-        let mut pos = [0u64; 6];
+        let mut neg = [0u64; 3];
+        let mut pos = [0u64; 3];
         for (gi, g) in self.groups.iter().enumerate() {
             #[cfg(target_arch = "x86_64")]
             if std::is_x86_feature_detected!("avx") {
                 // SAFETY: the CPU has AVX (checked above).
                 let (n4, p4) = unsafe { planes4_avx(g, &cu, &ru, m) };
-                for p in 0..6 {
+                for p in 0..3 {
                     neg[p] |= (n4[p] as u64) << (4 * gi);
                     pos[p] |= (p4[p] as u64) << (4 * gi);
                 }
                 continue;
             }
-            for p in 0..6 {
-                let margin = if p < 3 { m } else { 2.0 * m };
+            for p in 0..3 {
+                let margin = m;
                 for lane in 0..4 {
                     let n = [0, 1, 2].map(|a| g.n[p][a][lane]);
                     let s = [0, 1, 2].map(|a| g.abs[p][a][lane]);
@@ -229,11 +233,7 @@ impl ShadowCull {
                 }
             }
         }
-        let (any_neg, any_pos) = (neg[0] | neg[1] | neg[2], pos[0] | pos[1] | pos[2]);
-        let mut culled = any_neg & any_pos;
-        for e in 0..3 {
-            culled |= (neg[e] & pos[3 + e]) | (pos[e] & neg[3 + e]);
-        }
+        let culled = (neg[0] | neg[1] | neg[2]) & (pos[0] | pos[1] | pos[2]);
         let all = if self.tris.len() == 64 {
             u64::MAX
         } else {
@@ -251,7 +251,7 @@ impl ShadowCull {
 /// The CPU must have AVX.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
-unsafe fn planes4_avx(g: &Planes4, cu: &[f64; 3], ru: &[f64; 3], m: f64) -> ([u32; 6], [u32; 6]) {
+unsafe fn planes4_avx(g: &Planes4, cu: &[f64; 3], ru: &[f64; 3], m: f64) -> ([u32; 3], [u32; 3]) {
     use std::arch::x86_64::*;
     // SAFETY: each load reads a whole 32-byte-aligned `[f64; 4]`.
     let ld = |a: &[f64; 4]| unsafe { _mm256_load_pd(a.as_ptr()) };
@@ -265,9 +265,10 @@ unsafe fn planes4_avx(g: &Planes4, cu: &[f64; 3], ru: &[f64; 3], m: f64) -> ([u3
         _mm256_set1_pd(ru[1]),
         _mm256_set1_pd(ru[2]),
     );
-    let (mut neg, mut pos) = ([0; 6], [0; 6]);
-    for p in 0..6 {
-        let margin = _mm256_set1_pd(if p < 3 { m } else { 2.0 * m });
+    let (mut neg, mut pos) = ([0; 3], [0; 3]);
+    let margin = _mm256_set1_pd(m);
+    let below = _mm256_sub_pd(_mm256_setzero_pd(), margin);
+    for p in 0..3 {
         let n = &g.n[p];
         let a = &g.abs[p];
         let f = _mm256_add_pd(
@@ -278,7 +279,6 @@ unsafe fn planes4_avx(g: &Planes4, cu: &[f64; 3], ru: &[f64; 3], m: f64) -> ([u3
             _mm256_add_pd(_mm256_mul_pd(ld(&a[0]), r0), _mm256_mul_pd(ld(&a[1]), r1)),
             _mm256_mul_pd(ld(&a[2]), r2),
         );
-        let below = _mm256_sub_pd(_mm256_setzero_pd(), margin);
         neg[p] = _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_add_pd(f, s), below)) as u32;
         pos[p] =
             _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(_mm256_sub_pd(f, s), margin)) as u32;
@@ -318,7 +318,7 @@ impl ShadowCull {
                 continue;
             }
             // SAFETY: the CPU has AVX2 (this function's contract).
-            let (hit, redo) = unsafe { any_hit8_avx2(&t.v, rays, t_max) };
+            let (hit, redo) = unsafe { any_hit8_avx2(&t.lanes, rays, t_max) };
             blocked |= hit & lanes;
             let mut redo = redo & lanes & !blocked;
             while redo != 0 {

@@ -205,19 +205,25 @@ impl SceneBuilder {
     /// first bad one in the order added.
     pub fn build(self, name: &str, camera: Camera, effects: Effects) -> Result<Scene, SceneError> {
         // Validated in parallel straight into place (an indexed collect: no intermediate
-        // lists); a failure only raises a flag, and then a sequential pass finds the first.
+        // lists); a failure only raises a flag, and then a sequential pass finds the first. A
+        // small scene is checked on this thread: the pool is not even started for it.
+        let small = self.raw.len() < PAR_MIN_TRIANGLES;
         let failed = AtomicBool::new(false);
-        let mut triangles = Vec::new();
-        self.raw
-            .par_iter()
-            .with_min_len(PAR_MIN_TRIANGLES)
-            .map(|&([a, b, c], m)| {
-                Triangle::new(a, b, c, m).unwrap_or_else(|_| {
-                    failed.store(true, Ordering::Relaxed);
-                    PLACEHOLDER
-                })
+        let validate = |&([a, b, c], m): &([Vec3; 3], u32)| {
+            Triangle::new(a, b, c, m).unwrap_or_else(|_| {
+                failed.store(true, Ordering::Relaxed);
+                PLACEHOLDER
             })
-            .collect_into_vec(&mut triangles);
+        };
+        let mut triangles = Vec::new();
+        if small {
+            triangles = self.raw.iter().map(validate).collect();
+        } else {
+            self.raw
+                .par_iter()
+                .map(validate)
+                .collect_into_vec(&mut triangles);
+        }
         if failed.into_inner() {
             let (index, problem) = self
                 .raw
@@ -228,11 +234,13 @@ impl SceneBuilder {
             return Err(SceneError::Triangle { index, problem });
         }
         let materials = self.materials.len();
-        if let Some(index) = triangles
-            .par_iter()
-            .with_min_len(PAR_MIN_TRIANGLES)
-            .position_first(|t| t.material as usize >= materials)
-        {
+        let bad_material = |t: &Triangle| t.material as usize >= materials;
+        let first_bad = if small {
+            triangles.iter().position(bad_material)
+        } else {
+            triangles.par_iter().position_first(bad_material)
+        };
+        if let Some(index) = first_bad {
             return Err(SceneError::Material { index });
         }
         if let Some(index) = self.lights.iter().position(|l| {
@@ -240,11 +248,18 @@ impl SceneBuilder {
         }) {
             return Err(SceneError::Light { index });
         }
-        let bounds = triangles
-            .par_iter()
-            .with_min_len(PAR_MIN_TRIANGLES)
-            .map(Aabb::of_triangle)
-            .reduce(|| Aabb::EMPTY, Aabb::union);
+        // The union of boxes is exact (min and max), so any order gives the same bounds.
+        let bounds = if small {
+            triangles
+                .iter()
+                .map(Aabb::of_triangle)
+                .fold(Aabb::EMPTY, Aabb::union)
+        } else {
+            triangles
+                .par_iter()
+                .map(Aabb::of_triangle)
+                .reduce(|| Aabb::EMPTY, Aabb::union)
+        };
         let extent = if triangles.is_empty() {
             1.0
         } else {
@@ -415,9 +430,9 @@ impl Scene {
     }
 }
 
-/// Triangles per piece of the build's parallel passes (validation, materials, bounds): a
-/// piece costs microseconds, so a smaller scene (the Cornell box's 30) is checked on the calling
-/// thread, without the 0.1-0.3 ms of waking the pool's threads and waiting for them three times.
+/// Scenes with fewer triangles are built on the calling thread (validation, materials,
+/// bounds: microseconds for them), without starting the thread pool or waking it three times
+/// (0.1-0.3 ms for the Cornell box's 30); the render starts the pool when it needs it.
 const PAR_MIN_TRIANGLES: usize = 4096;
 
 /// The point light is treated as a sphere of this radius, as a fraction of the scene's

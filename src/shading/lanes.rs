@@ -26,18 +26,30 @@ type Lanes = [[f32; N]; 3];
 
 const ZERO: Lanes = [[0.0; N]; 3];
 
+/// Per triangle of a small scene: vertices, normal, material colour, structure of arrays, for
+/// gathering eight lanes at once; which triangles are shaded in lanes; each light's cull.
+#[derive(Debug)]
+pub(super) struct Tables {
+    /// `v[vertex][axis][triangle]`.
+    v: [[[f32; SHADOW_TILE_TRIANGLES]; 3]; 3],
+    normal: [[f32; SHADOW_TILE_TRIANGLES]; 3],
+    colour: [[f32; SHADOW_TILE_TRIANGLES]; 3],
+    /// Bit `t`: triangle `t`'s hits are shaded in lanes (else one at a time, as `shade` does
+    /// mirrors and black surfaces).
+    own: u64,
+    /// One per light, when shadows are traced.
+    culls: Vec<ShadowCull>,
+}
+
 /// What [`Tracer::shade_tile_lanes`] keeps between tiles (one per band of tiles).
 #[derive(Clone, Debug)]
 pub(super) struct LaneScratch {
-    /// Each shaded pixel's index in the tile.
+    /// Each shaded pixel's index in the tile, and its triangle.
     idx: [u8; N],
-    /// Gathered per shaded pixel: barycentrics, the triangle's vertices, its normal, the
-    /// ray's direction, the material's colour.
+    tri: [i32; N],
+    /// Gathered per shaded pixel: barycentrics, the ray's direction.
     bary: Lanes,
-    v: [Lanes; 3],
-    tri_normal: Lanes,
     ray_dir: Lanes,
-    colour: Lanes,
     /// The hit point, its error bound, the normal facing the ray, the sum over the lights.
     p: Lanes,
     err: Lanes,
@@ -47,19 +59,15 @@ pub(super) struct LaneScratch {
     term: Lanes,
     origin: Lanes,
     dir: Lanes,
-    /// One cull per light, built on first use.
-    culls: Vec<Option<ShadowCull>>,
 }
 
 impl Default for LaneScratch {
     fn default() -> LaneScratch {
         LaneScratch {
             idx: [0; N],
+            tri: [0; N],
             bary: ZERO,
-            v: [ZERO; 3],
-            tri_normal: ZERO,
             ray_dir: ZERO,
-            colour: ZERO,
             p: ZERO,
             err: ZERO,
             normal: ZERO,
@@ -67,7 +75,6 @@ impl Default for LaneScratch {
             term: ZERO,
             origin: ZERO,
             dir: ZERO,
-            culls: vec![],
         }
     }
 }
@@ -105,38 +112,37 @@ impl Tracer<'_> {
         s: &mut LaneScratch,
     ) {
         let mode = self.settings.mode;
-        let (tris, materials) = (self.scene.triangles(), self.scene.materials());
-        // Gather the pixels shaded here; the others are shaded one at a time.
+        let tables = &**self.tables.get_or_init(|| Box::new(self.tables()));
+        // Gather the pixels shaded here; the others are shaded one at a time, after.
+        let k = rays.len().min(N);
+        let hits = &hits[..k];
         let mut m = 0;
-        for (i, hit) in hits.iter().enumerate() {
-            let Some(hit) = hit else {
+        let mut others = 0u64;
+        for i in 0..k {
+            let Some(hit) = &hits[i] else {
                 out[i] = Vec3::ZERO;
                 continue;
             };
-            let tri = &tris[hit.triangle as usize];
-            let material = &materials[tri.material as usize];
-            // As `shade`: flat colour; a black surface or a mirror (shaded one at a time).
-            let own = mode == Mode::Irradiance
-                || (mode == Mode::Colour
-                    && !(material.mirror > 0.0)
-                    && material.colour != Vec3::ZERO);
-            if !own {
-                let ray = rays.ray(i);
-                out[i] = self.shade_primary(&ray, Some(*hit), &mut crate::rng::Rng::seeded(0), n);
-                continue;
-            }
+            let own = tables.own >> hit.triangle & 1;
+            others |= (own ^ 1) << i;
+            // (`m < N`: the mask only tells the compiler so.)
+            let j = m & (N - 1);
             let dir = rays.dir(i);
-            for k in 0..3 {
-                s.bary[k][m] = hit.b[k];
-                for j in 0..3 {
-                    s.v[j][k][m] = tri.v[j][k];
-                }
-                s.tri_normal[k][m] = tri.normal[k];
-                s.ray_dir[k][m] = dir[k];
-                s.colour[k][m] = material.colour[k];
-            }
-            s.idx[m] = i as u8;
-            m += 1;
+            s.bary[0][j] = hit.b[0];
+            s.bary[1][j] = hit.b[1];
+            s.bary[2][j] = hit.b[2];
+            s.ray_dir[0][j] = dir.x;
+            s.ray_dir[1][j] = dir.y;
+            s.ray_dir[2][j] = dir.z;
+            s.tri[j] = hit.triangle as i32;
+            s.idx[j] = i as u8;
+            m += own as usize;
+        }
+        while others != 0 {
+            let i = others.trailing_zeros() as usize;
+            others &= others - 1;
+            let mut rng = crate::rng::Rng::seeded(0);
+            out[i] = self.shade_primary(&rays.ray(i), hits[i], &mut rng, n);
         }
         if m == 0 {
             return;
@@ -146,7 +152,7 @@ impl Tracer<'_> {
         let valid = |c: usize| (1u32 << (m - 8 * c).min(8)) - 1;
         let t_max = 1.0 - SHADOW_EPSILON;
         for c in 0..chunks {
-            self.hit_points8(s, 8 * c);
+            hit_points8(tables, s, 8 * c);
         }
         s.sum = ZERO;
         for (li, light) in self.lights.iter().enumerate() {
@@ -166,20 +172,12 @@ impl Tracer<'_> {
                 let count: u32 = traced.iter().map(|t| t.count_ones()).sum();
                 n.shadow += count as u64;
                 if count > 0 {
-                    if s.culls.len() <= li {
-                        s.culls.resize(li + 1, None);
-                    }
-                    if !s.culls[li]
-                        .as_ref()
-                        .is_some_and(|c| c.is_for(light.position))
-                    {
-                        s.culls[li] = Some(ShadowCull::new(tris, light.position));
-                    }
+                    let cull = &tables.culls[li];
                     let (lo, hi) = origin_box(s, &traced[..chunks]);
-                    let kept = s.culls[li].as_ref().expect("built above").kept(lo, hi);
+                    let kept = cull.kept(lo, hi);
                     for c in 0..chunks {
                         if traced[c] != 0 {
-                            blocked[c] = shadows8(s, li, kept, 8 * c, traced[c], t_max);
+                            blocked[c] = shadows8(s, cull, kept, 8 * c, traced[c], t_max);
                         }
                     }
                 }
@@ -198,13 +196,16 @@ impl Tracer<'_> {
             // SAFETY: reads eight `f32`s.
             let ld = |a: &[f32; N]| unsafe { _mm256_loadu_ps(a[o..].as_ptr()) };
             let mut colour = [[0f32; 8]; 3];
+            // SAFETY: reads eight `i32`s.
+            let ids = unsafe { _mm256_loadu_si256(s.tri[o..].as_ptr().cast()) };
             for k in 0..3 {
                 let sum = ld(&s.sum[k]);
                 // `material.colour * (sum + indirect)`, or the irradiance alone.
                 let v = match indirect {
-                    Some(i) => {
-                        _mm256_mul_ps(ld(&s.colour[k]), _mm256_add_ps(sum, _mm256_set1_ps(i)))
-                    }
+                    Some(i) => _mm256_mul_ps(
+                        gather(&tables.colour[k], ids),
+                        _mm256_add_ps(sum, _mm256_set1_ps(i)),
+                    ),
                     None => sum,
                 };
                 // SAFETY: writes eight `f32`s.
@@ -218,41 +219,41 @@ impl Tracer<'_> {
         }
     }
 
-    /// `hit_point` and the normal facing the ray for the eight pixels from `o`.
-    #[target_feature(enable = "avx2")]
-    fn hit_points8(&self, s: &mut LaneScratch, o: usize) {
-        let ld = |a: &[f32; N]| unsafe { _mm256_loadu_ps(a[o..].as_ptr()) };
-        let st = |a: &mut [f32; N], v: __m256| unsafe { _mm256_storeu_ps(a[o..].as_mut_ptr(), v) };
-        let (b0, b1, b2) = (ld(&s.bary[0]), ld(&s.bary[1]), ld(&s.bary[2]));
-        let g7 = _mm256_set1_ps(gamma(7));
-        let sign = _mm256_set1_ps(-0.0);
-        for k in 0..3 {
-            let (v0, v1, v2) = (ld(&s.v[0][k]), ld(&s.v[1][k]), ld(&s.v[2][k]));
-            let (p0, p1, p2) = (
-                _mm256_mul_ps(v0, b0),
-                _mm256_mul_ps(v1, b1),
-                _mm256_mul_ps(v2, b2),
-            );
-            // glam's `min`/`max`: `a < b ? a : b`, `a > b ? a : b`, as SSE's.
-            let lo = _mm256_min_ps(_mm256_min_ps(v0, v1), v2);
-            let hi = _mm256_max_ps(_mm256_max_ps(v0, v1), v2);
-            let sum = _mm256_add_ps(_mm256_add_ps(p0, p1), p2);
-            st(&mut s.p[k], _mm256_min_ps(_mm256_max_ps(sum, lo), hi));
-            let abs = |v| _mm256_andnot_ps(sign, v);
-            let e = _mm256_add_ps(_mm256_add_ps(abs(p0), abs(p1)), abs(p2));
-            st(&mut s.err[k], _mm256_mul_ps(e, g7));
+    /// The tables of [`Tracer::shade_tile_lanes`] for this frame (a small scene).
+    fn tables(&self) -> Tables {
+        let mut t = Tables {
+            v: [[[0.0; SHADOW_TILE_TRIANGLES]; 3]; 3],
+            normal: [[0.0; SHADOW_TILE_TRIANGLES]; 3],
+            colour: [[0.0; SHADOW_TILE_TRIANGLES]; 3],
+            own: 0,
+            culls: vec![],
+        };
+        let mode = self.settings.mode;
+        let materials = self.scene.materials();
+        for (i, tri) in self.scene.triangles().iter().enumerate() {
+            let material = &materials[tri.material as usize];
+            for k in 0..3 {
+                for j in 0..3 {
+                    t.v[j][k][i] = tri.v[j][k];
+                }
+                t.normal[k][i] = tri.normal[k];
+                t.colour[k][i] = material.colour[k];
+            }
+            // As `shade`: flat colour; a black surface or a mirror (shaded one at a time).
+            let own = mode == Mode::Irradiance
+                || (mode == Mode::Colour
+                    && !(material.mirror > 0.0)
+                    && material.colour != Vec3::ZERO);
+            t.own |= (own as u64) << i;
         }
-        // Two-sided shading: the normal on the side the ray came from.
-        let [nx, ny, nz] = s.tri_normal.each_ref().map(ld);
-        let [dx, dy, dz] = s.ray_dir.each_ref().map(ld);
-        let dot = _mm256_add_ps(
-            _mm256_add_ps(_mm256_mul_ps(nx, dx), _mm256_mul_ps(ny, dy)),
-            _mm256_mul_ps(nz, dz),
-        );
-        let flip = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(dot, _mm256_setzero_ps()), sign);
-        for (k, c) in [nx, ny, nz].into_iter().enumerate() {
-            st(&mut s.normal[k], _mm256_xor_ps(c, flip));
+        if self.settings.effects.shadows {
+            t.culls = self
+                .lights
+                .iter()
+                .map(|l| ShadowCull::new(self.scene.triangles(), l.position))
+                .collect();
         }
+        t
     }
 
     /// `light_term` for the eight pixels from `o`: the term, origin and direction into `s`,
@@ -261,9 +262,9 @@ impl Tracer<'_> {
     fn light_terms8(&self, light: &PointLight, s: &mut LaneScratch, o: usize) -> (u32, u32) {
         let ld = |a: &[f32; N]| unsafe { _mm256_loadu_ps(a[o..].as_ptr()) };
         let st = |a: &mut [f32; N], v: __m256| unsafe { _mm256_storeu_ps(a[o..].as_mut_ptr(), v) };
-        let [px, py, pz] = s.p.each_ref().map(ld);
-        let [ex, ey, ez] = s.err.each_ref().map(ld);
-        let [nx, ny, nz] = s.normal.each_ref().map(ld);
+        let (px, py, pz) = (ld(&s.p[0]), ld(&s.p[1]), ld(&s.p[2]));
+        let (ex, ey, ez) = (ld(&s.err[0]), ld(&s.err[1]), ld(&s.err[2]));
+        let (nx, ny, nz) = (ld(&s.normal[0]), ld(&s.normal[1]), ld(&s.normal[2]));
         let sp = |v: f32| _mm256_set1_ps(v);
         let (add, sub, mul, div) = (
             |a, b| _mm256_add_ps(a, b),
@@ -287,8 +288,14 @@ impl Tracer<'_> {
         // `dist2.max(min_r2)`: dist2 > 0 where it matters, never NaN there.
         let denom = mul(sp(4.0 * PI), _mm256_max_ps(dist2, sp(self.min_r2)));
         let pw = light.power;
-        for (k, c) in [pw.x, pw.y, pw.z].into_iter().enumerate() {
-            st(&mut s.term[k], div(mul(sp(c), cos), denom));
+        let mut term = [div(mul(sp(pw.x), cos), denom); 3];
+        // A white light's three terms are one value (the same operations on the same inputs).
+        if pw.y.to_bits() != pw.x.to_bits() || pw.z.to_bits() != pw.x.to_bits() {
+            term[1] = div(mul(sp(pw.y), cos), denom);
+            term[2] = div(mul(sp(pw.z), cos), denom);
+        }
+        for (k, t) in term.into_iter().enumerate() {
+            st(&mut s.term[k], t);
         }
         // `offset_ray_origin(p, err, normal, to_light)`.
         let d = add(add(mul(abs(nx), ex), mul(abs(ny), ey)), mul(abs(nz), ez));
@@ -341,30 +348,135 @@ impl Tracer<'_> {
     }
 }
 
+/// Eight lanes of `table` at triangles `ids` (all in the table).
+#[target_feature(enable = "avx2")]
+fn gather(table: &[f32; SHADOW_TILE_TRIANGLES], ids: __m256i) -> __m256 {
+    // SAFETY: every id indexes the table (the scene's triangles, at most its length).
+    unsafe { _mm256_i32gather_ps::<4>(table.as_ptr(), ids) }
+}
+
+/// `hit_point` and the normal facing the ray for the eight pixels from `o`.
+#[target_feature(enable = "avx2")]
+fn hit_points8(t: &Tables, s: &mut LaneScratch, o: usize) {
+    let ld = |a: &[f32; N]| unsafe { _mm256_loadu_ps(a[o..].as_ptr()) };
+    let st = |a: &mut [f32; N], v: __m256| unsafe { _mm256_storeu_ps(a[o..].as_mut_ptr(), v) };
+    // SAFETY: reads eight `i32`s.
+    let ids = unsafe { _mm256_loadu_si256(s.tri[o..].as_ptr().cast()) };
+    // Eight hits on one triangle (the common case): its values splatted, else gathered.
+    let first = s.tri[o];
+    let same = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(
+        ids,
+        _mm256_set1_epi32(first),
+    ))) == 0xff;
+    let get = |a: &[f32; SHADOW_TILE_TRIANGLES]| {
+        if same {
+            _mm256_set1_ps(a[first as usize])
+        } else {
+            gather(a, ids)
+        }
+    };
+    let (b0, b1, b2) = (ld(&s.bary[0]), ld(&s.bary[1]), ld(&s.bary[2]));
+    let g7 = _mm256_set1_ps(gamma(7));
+    let sign = _mm256_set1_ps(-0.0);
+    for k in 0..3 {
+        let (v0, v1, v2) = (get(&t.v[0][k]), get(&t.v[1][k]), get(&t.v[2][k]));
+        let (p0, p1, p2) = (
+            _mm256_mul_ps(v0, b0),
+            _mm256_mul_ps(v1, b1),
+            _mm256_mul_ps(v2, b2),
+        );
+        // glam's `min`/`max`: `a < b ? a : b`, `a > b ? a : b`, as SSE's.
+        let lo = _mm256_min_ps(_mm256_min_ps(v0, v1), v2);
+        let hi = _mm256_max_ps(_mm256_max_ps(v0, v1), v2);
+        let sum = _mm256_add_ps(_mm256_add_ps(p0, p1), p2);
+        st(&mut s.p[k], _mm256_min_ps(_mm256_max_ps(sum, lo), hi));
+        let abs = |v| _mm256_andnot_ps(sign, v);
+        let e = _mm256_add_ps(_mm256_add_ps(abs(p0), abs(p1)), abs(p2));
+        st(&mut s.err[k], _mm256_mul_ps(e, g7));
+    }
+    // Two-sided shading: the normal on the side the ray came from.
+    let (nx, ny, nz) = (get(&t.normal[0]), get(&t.normal[1]), get(&t.normal[2]));
+    let (dx, dy, dz) = (ld(&s.ray_dir[0]), ld(&s.ray_dir[1]), ld(&s.ray_dir[2]));
+    let dot = _mm256_add_ps(
+        _mm256_add_ps(_mm256_mul_ps(nx, dx), _mm256_mul_ps(ny, dy)),
+        _mm256_mul_ps(nz, dz),
+    );
+    let flip = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(dot, _mm256_setzero_ps()), sign);
+    for (k, c) in [nx, ny, nz].into_iter().enumerate() {
+        st(&mut s.normal[k], _mm256_xor_ps(c, flip));
+    }
+}
+
+/// The lanes of a mask (bit per lane) as a vector mask.
+#[target_feature(enable = "avx2")]
+fn lane_mask(lanes: u32) -> __m256 {
+    let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+        _mm256_and_si256(_mm256_set1_epi32(lanes as i32), bits),
+        bits,
+    ))
+}
+
+/// The least and greatest of `v` over the lanes of `on` (a vector mask with a lane set).
+#[target_feature(enable = "avx2")]
+fn min_max8(v: __m256, on: __m256) -> (f32, f32) {
+    let lo = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), v, on);
+    let hi = _mm256_blendv_ps(_mm256_set1_ps(f32::NEG_INFINITY), v, on);
+    // Halves, then pairs, then neighbours (no lane is NaN: origins are finite).
+    let l = _mm_min_ps(_mm256_castps256_ps128(lo), _mm256_extractf128_ps::<1>(lo));
+    let l = _mm_min_ps(l, _mm_movehl_ps(l, l));
+    let l = _mm_min_ps(l, _mm_shuffle_ps::<1>(l, l));
+    let h = _mm_max_ps(_mm256_castps256_ps128(hi), _mm256_extractf128_ps::<1>(hi));
+    let h = _mm_max_ps(h, _mm_movehl_ps(h, h));
+    let h = _mm_max_ps(h, _mm_shuffle_ps::<1>(h, h));
+    (_mm_cvtss_f32(l), _mm_cvtss_f32(h))
+}
+
 /// The box of the origins of the `traced` lanes (bit per lane, a word per chunk of eight).
 #[target_feature(enable = "avx2")]
 fn origin_box(s: &LaneScratch, traced: &[u32]) -> (Vec3, Vec3) {
-    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    let mut lo = [_mm256_set1_ps(f32::INFINITY); 3];
+    let mut hi = [_mm256_set1_ps(f32::NEG_INFINITY); 3];
     for (c, &t) in traced.iter().enumerate() {
-        let mut t = t;
-        while t != 0 {
-            let l = 8 * c + t.trailing_zeros() as usize;
-            t &= t - 1;
-            for k in 0..3 {
-                lo[k] = lo[k].min(s.origin[k][l]);
-                hi[k] = hi[k].max(s.origin[k][l]);
-            }
+        if t == 0 {
+            continue;
+        }
+        let on = lane_mask(t);
+        for k in 0..3 {
+            // SAFETY: reads eight `f32`s.
+            let v = unsafe { _mm256_loadu_ps(s.origin[k][8 * c..].as_ptr()) };
+            lo[k] = _mm256_blendv_ps(lo[k], _mm256_min_ps(lo[k], v), on);
+            hi[k] = _mm256_blendv_ps(hi[k], _mm256_max_ps(hi[k], v), on);
         }
     }
-    (Vec3::from_array(lo), Vec3::from_array(hi))
+    let all = lane_mask(0xff);
+    let (x, y, z) = (
+        min_max8(lo[0], all),
+        min_max8(lo[1], all),
+        min_max8(lo[2], all),
+    );
+    let (lo, _) = ((x.0, y.0, z.0), ());
+    let (x, y, z) = (
+        min_max8(hi[0], all),
+        min_max8(hi[1], all),
+        min_max8(hi[2], all),
+    );
+    (Vec3::new(lo.0, lo.1, lo.2), Vec3::new(x.1, y.1, z.1))
 }
 
 /// The shadow rays of the `traced` lanes of the eight pixels from `o` against the `kept`
 /// triangles of light `li`'s cull, in packets of one axis order: the lanes blocked.
 #[target_feature(enable = "avx2")]
-fn shadows8(s: &LaneScratch, li: usize, kept: u64, o: usize, traced: u32, t_max: f32) -> u32 {
+fn shadows8(
+    s: &LaneScratch,
+    cull: &ShadowCull,
+    kept: u64,
+    o: usize,
+    traced: u32,
+    t_max: f32,
+) -> u32 {
     let ld = |a: &[f32; N]| unsafe { _mm256_loadu_ps(a[o..].as_ptr()) };
-    let [dx, dy, dz] = s.dir.each_ref().map(ld);
+    let (dx, dy, dz) = (ld(&s.dir[0]), ld(&s.dir[1]), ld(&s.dir[2]));
     let sign = _mm256_set1_ps(-0.0);
     let abs = |v| _mm256_andnot_ps(sign, v);
     let (ax, ay, az) = (abs(dx), abs(dy), abs(dz));
@@ -378,50 +490,53 @@ fn shadows8(s: &LaneScratch, li: usize, kept: u64, o: usize, traced: u32, t_max:
     let zero = _mm256_setzero_ps();
     let dirs = [dx, dy, dz];
     let negative = dirs.map(|d| mask(_mm256_cmp_ps::<_CMP_LT_OQ>(d, zero)));
+    // Each lane's class: its axis and the sign along it (`Ray::new`'s axes and swap).
+    let class = |l: usize| {
+        let kz = if on_x >> l & 1 == 1 {
+            0
+        } else if on_y >> l & 1 == 1 {
+            1
+        } else {
+            2
+        };
+        (kz, negative[kz] >> l & 1 == 1)
+    };
     let mut blocked = 0;
-    for kz in 0..3 {
-        for neg in [false, true] {
-            let side = if neg { negative[kz] } else { !negative[kz] };
-            let lanes = traced & by_axis[kz] & side;
-            if lanes == 0 {
-                continue;
-            }
-            let mut kx = (kz + 1) % 3;
-            let mut ky = (kx + 1) % 3;
-            if neg {
-                std::mem::swap(&mut kx, &mut ky);
-            }
-            let mut rays = ShadowRays8 {
-                axes: [kx, ky, kz],
-                ..ShadowRays8::default()
-            };
-            // The shear, as `Ray::with_inverse` computes it: `sz = 1/d_kz`, `sx = −d_kx·sz`.
-            let sz = _mm256_div_ps(_mm256_set1_ps(1.0), dirs[kz]);
-            let sx = _mm256_mul_ps(_mm256_xor_ps(dirs[kx], sign), sz);
-            let sy = _mm256_mul_ps(_mm256_xor_ps(dirs[ky], sign), sz);
-            for (row, v) in rays.shear.iter_mut().zip([sx, sy, sz]) {
-                // SAFETY: writes eight `f32`s.
-                unsafe { _mm256_store_ps(row.as_mut_ptr(), v) };
-            }
-            for (row, k) in rays.origin.iter_mut().zip([kx, ky, kz]) {
-                row.copy_from_slice(&s.origin[k][o..o + 8]);
-            }
-            let mut oz = (f32::INFINITY, f32::NEG_INFINITY);
-            let mut m = lanes;
-            while m != 0 {
-                let l = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let z = rays.origin[2][l];
-                oz = (oz.0.min(z), oz.1.max(z));
-            }
-            let ray = |l: usize| {
-                let v = |a: &Lanes| Vec3::new(a[0][o + l], a[1][o + l], a[2][o + l]);
-                Ray::new(v(&s.origin), v(&s.dir))
-            };
-            // SAFETY: this function runs with AVX2.
-            let cull = s.culls[li].as_ref().expect("built by the caller");
-            blocked |= unsafe { cull.occluded8_avx2(kept, &rays, lanes, oz, t_max, ray) };
+    let mut left = traced;
+    while left != 0 {
+        let (kz, neg) = class(left.trailing_zeros() as usize);
+        let side = if neg { negative[kz] } else { !negative[kz] };
+        let lanes = left & by_axis[kz] & side;
+        left &= !lanes;
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if neg {
+            std::mem::swap(&mut kx, &mut ky);
         }
+        let mut rays = ShadowRays8 {
+            axes: [kx, ky, kz],
+            ..ShadowRays8::default()
+        };
+        // The shear, as `Ray::with_inverse` computes it: `sz = 1/d_kz`, `sx = −d_kx·sz`.
+        let sz = _mm256_div_ps(_mm256_set1_ps(1.0), dirs[kz]);
+        let sx = _mm256_mul_ps(_mm256_xor_ps(dirs[kx], sign), sz);
+        let sy = _mm256_mul_ps(_mm256_xor_ps(dirs[ky], sign), sz);
+        // SAFETY: each writes or reads eight `f32`s.
+        unsafe {
+            _mm256_store_ps(rays.shear[0].as_mut_ptr(), sx);
+            _mm256_store_ps(rays.shear[1].as_mut_ptr(), sy);
+            _mm256_store_ps(rays.shear[2].as_mut_ptr(), sz);
+            for (row, k) in rays.origin.iter_mut().zip([kx, ky, kz]) {
+                _mm256_store_ps(row.as_mut_ptr(), ld(&s.origin[k]));
+            }
+        }
+        let oz = min_max8(ld(&s.origin[kz]), lane_mask(lanes));
+        let ray = |l: usize| {
+            let v = |a: &Lanes| Vec3::new(a[0][o + l], a[1][o + l], a[2][o + l]);
+            Ray::new(v(&s.origin), v(&s.dir))
+        };
+        // SAFETY: this function runs with AVX2.
+        blocked |= unsafe { cull.occluded8_avx2(kept, &rays, lanes, oz, t_max, ray) };
     }
     blocked
 }
@@ -432,11 +547,7 @@ fn add_terms8(s: &mut LaneScratch, o: usize, lanes: u32) {
     if lanes == 0 {
         return;
     }
-    let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-    let on = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
-        _mm256_and_si256(_mm256_set1_epi32(lanes as i32), bits),
-        bits,
-    ));
+    let on = lane_mask(lanes);
     for k in 0..3 {
         // SAFETY: reads and writes eight `f32`s.
         unsafe {

@@ -50,6 +50,9 @@ pub struct Tracer<'a> {
     lights: &'a [PointLight],
     settings: Settings,
     min_r2: f32,
+    /// What [`Tracer::shade_tile_lanes`] reads per triangle and light, built on first use.
+    #[cfg(target_arch = "x86_64")]
+    tables: std::sync::OnceLock<Box<lanes::Tables>>,
 }
 
 impl<'a> Tracer<'a> {
@@ -61,6 +64,8 @@ impl<'a> Tracer<'a> {
             lights,
             settings,
             min_r2: r * r,
+            #[cfg(target_arch = "x86_64")]
+            tables: std::sync::OnceLock::new(),
         }
     }
 

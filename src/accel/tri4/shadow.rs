@@ -5,8 +5,6 @@
 //! [`crate::geometry::intersect_watertight`] accepts it; a lane whose edge function rounds to
 //! 0 is handed back (`redo`) for the scalar test's `f64` edges.
 
-use glam::Vec3;
-
 use super::LANES;
 use super::x86::{avx, watertight_lanes};
 use crate::geometry::gamma;
@@ -24,7 +22,7 @@ pub struct ShadowRays8 {
     pub axes: [usize; 3],
 }
 
-/// Which lanes of `rays` hit triangle `v` before `t_max` (bit per lane), and which lanes the
+/// Which lanes of `rays` hit the triangle of vertices `v` (each `[x, y, z, 0]`) before `t_max` (bit per lane), and which lanes the
 /// scalar test must redo (an edge function rounded to 0). Lanes that hold no ray give
 /// meaningless bits: callers mask them.
 ///
@@ -32,23 +30,31 @@ pub struct ShadowRays8 {
 /// The CPU must have AVX2.
 #[target_feature(enable = "avx2")]
 #[inline]
-pub unsafe fn any_hit8_avx2(v: &[Vec3; 3], rays: &ShadowRays8, t_max: f32) -> (u32, u32) {
+pub unsafe fn any_hit8_avx2(v: &[[f32; 4]; 3], rays: &ShadowRays8, t_max: f32) -> (u32, u32) {
     use avx::*;
     use std::arch::x86_64::*;
     // SAFETY: every load reads a whole 32-byte-aligned `[f32; 8]`.
     let load = |p: &[f32; 8]| unsafe { _mm256_load_ps(p.as_ptr()) };
     let [kx, ky, kz] = rays.axes;
-    let [ox, oy, oz] = rays.origin.each_ref().map(load);
+    let (ox, oy, oz) = (
+        load(&rays.origin[0]),
+        load(&rays.origin[1]),
+        load(&rays.origin[2]),
+    );
     // `RayFrame`: each vertex relative to each lane's origin, in the axis order.
-    let rel = |p: Vec3| {
+    let rel = |p: &[f32; 4]| {
         (
             sub(splat(p[kx]), ox),
             sub(splat(p[ky]), oy),
             sub(splat(p[kz]), oz),
         )
     };
-    let ((a0, b0, z0), (a1, b1, z1), (a2, b2, z2)) = (rel(v[0]), rel(v[1]), rel(v[2]));
-    let [sx, sy, sz] = rays.shear.each_ref().map(load);
+    let ((a0, b0, z0), (a1, b1, z1), (a2, b2, z2)) = (rel(&v[0]), rel(&v[1]), rel(&v[2]));
+    let (sx, sy, sz) = (
+        load(&rays.shear[0]),
+        load(&rays.shear[1]),
+        load(&rays.shear[2]),
+    );
     let (hit, redo, ..) = watertight_lanes!(
         avx,
         [a0, b0, z0, a1, b1, z1, a2, b2, z2],
