@@ -45,11 +45,10 @@ pub(super) struct Tables {
 #[derive(Clone, Debug)]
 pub(super) struct LaneScratch {
     /// Each shaded pixel's index in the tile, and its triangle.
-    idx: [u8; N],
+    idx: [i32; N],
     tri: [i32; N],
-    /// Gathered per shaded pixel: barycentrics, the ray's direction.
+    /// Gathered per shaded pixel: barycentrics.
     bary: Lanes,
-    ray_dir: Lanes,
     /// The hit point, its error bound, the normal facing the ray, the sum over the lights.
     p: Lanes,
     err: Lanes,
@@ -67,7 +66,6 @@ impl Default for LaneScratch {
             idx: [0; N],
             tri: [0; N],
             bary: ZERO,
-            ray_dir: ZERO,
             p: ZERO,
             err: ZERO,
             normal: ZERO,
@@ -127,15 +125,11 @@ impl Tracer<'_> {
             others |= (own ^ 1) << i;
             // (`m < N`: the mask only tells the compiler so.)
             let j = m & (N - 1);
-            let dir = rays.dir(i);
             s.bary[0][j] = hit.b[0];
             s.bary[1][j] = hit.b[1];
             s.bary[2][j] = hit.b[2];
-            s.ray_dir[0][j] = dir.x;
-            s.ray_dir[1][j] = dir.y;
-            s.ray_dir[2][j] = dir.z;
             s.tri[j] = hit.triangle as i32;
-            s.idx[j] = i as u8;
+            s.idx[j] = i as i32;
             m += own as usize;
         }
         while others != 0 {
@@ -152,7 +146,7 @@ impl Tracer<'_> {
         let valid = |c: usize| (1u32 << (m - 8 * c).min(8)) - 1;
         let t_max = 1.0 - SHADOW_EPSILON;
         for c in 0..chunks {
-            hit_points8(tables, s, 8 * c);
+            hit_points8(tables, s, rays.dir_lanes(), 8 * c, (m - 8 * c).min(8));
         }
         s.sum = ZERO;
         for (li, light) in self.lights.iter().enumerate() {
@@ -355,9 +349,10 @@ fn gather(table: &[f32; SHADOW_TILE_TRIANGLES], ids: __m256i) -> __m256 {
     unsafe { _mm256_i32gather_ps::<4>(table.as_ptr(), ids) }
 }
 
-/// `hit_point` and the normal facing the ray for the eight pixels from `o`.
+/// `hit_point` and the normal facing the ray for the `count` (1 to 8) pixels from `o`
+/// (`dirs`: the tile's ray directions).
 #[target_feature(enable = "avx2")]
-fn hit_points8(t: &Tables, s: &mut LaneScratch, o: usize) {
+fn hit_points8(t: &Tables, s: &mut LaneScratch, dirs: &Lanes, o: usize, count: usize) {
     let ld = |a: &[f32; N]| unsafe { _mm256_loadu_ps(a[o..].as_ptr()) };
     let st = |a: &mut [f32; N], v: __m256| unsafe { _mm256_storeu_ps(a[o..].as_mut_ptr(), v) };
     // SAFETY: reads eight `i32`s.
@@ -396,7 +391,23 @@ fn hit_points8(t: &Tables, s: &mut LaneScratch, o: usize) {
     }
     // Two-sided shading: the normal on the side the ray came from.
     let (nx, ny, nz) = (get(&t.normal[0]), get(&t.normal[1]), get(&t.normal[2]));
-    let (dx, dy, dz) = (ld(&s.ray_dir[0]), ld(&s.ray_dir[1]), ld(&s.ray_dir[2]));
+    // The rays' directions: the tile's own lanes when these `count` pixels are the tile's
+    // pixels `o..` (indices only grow, so the last one tells), else gathered.
+    let last = o + count - 1;
+    let in_place = s.idx[last] == last as i32;
+    let dir = |k: usize| {
+        if in_place {
+            ld(&dirs[k])
+        } else {
+            // SAFETY: every index is a pixel of the tile (at most `N`; stale lanes past the
+            // last pixel hold indices of earlier tiles, also below `N`).
+            unsafe {
+                let idx = _mm256_loadu_si256(s.idx[o..].as_ptr().cast());
+                _mm256_i32gather_ps::<4>(dirs[k].as_ptr(), idx)
+            }
+        }
+    };
+    let (dx, dy, dz) = (dir(0), dir(1), dir(2));
     let dot = _mm256_add_ps(
         _mm256_add_ps(_mm256_mul_ps(nx, dx), _mm256_mul_ps(ny, dy)),
         _mm256_mul_ps(nz, dz),
