@@ -178,22 +178,24 @@ impl Bvh {
     }
 
     /// [`Bvh::intersect_isa`] for each of `tile`'s rays, into `hits` (as many): the path picked
-    /// once for them all. `isa` must be available.
+    /// once for them all. `found(triangle)` is called as soon as a ray's hit is known (to
+    /// prefetch what shading will read). `isa` must be available.
     pub(super) fn intersect_tile(
         &self,
         isa: Isa,
         tile: &RayTile,
         t_max: f32,
         hits: &mut [Option<Hit>],
+        found: impl Fn(u32),
     ) {
         debug_assert!(isa.available(), "{} is not available", isa.name());
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller passes an available path.
-            Isa::Avx2 => unsafe { closest_each_avx2(self, tile, t_max, hits) },
+            Isa::Avx2 => unsafe { closest_each_avx2(self, tile, t_max, hits, found) },
             #[cfg(target_arch = "x86_64")]
-            Isa::Sse2 => self.closest_each::<Sse2>(tile, t_max, hits),
-            _ => self.closest_each::<Portable>(tile, t_max, hits),
+            Isa::Sse2 => self.closest_each::<Sse2>(tile, t_max, hits, found),
+            _ => self.closest_each::<Portable>(tile, t_max, hits, found),
         }
     }
 
@@ -217,9 +219,13 @@ impl Bvh {
         tile: &RayTile,
         t_max: f32,
         hits: &mut [Option<Hit>],
+        found: impl Fn(u32),
     ) {
         for (i, h) in hits.iter_mut().enumerate() {
             *h = self.closest::<K>(&tile.ray(i), t_max);
+            if let Some(h) = h {
+                found(h.triangle);
+            }
         }
     }
 
@@ -357,6 +363,16 @@ impl Bvh {
     }
 }
 
+/// Asks for the cache lines of `x` (at most two: it is at most 64 bytes). A hint: it reads
+/// nothing, cannot fault and changes no result.
+#[inline(always)]
+pub(crate) fn prefetch_value<T>(x: &T) {
+    const { assert!(std::mem::size_of::<T>() <= 64) };
+    let p = (x as *const T).cast::<u8>();
+    prefetch(p);
+    prefetch(p.wrapping_add(std::mem::size_of::<T>() - 1));
+}
+
 /// Asks for the cache line at `p` (a hint: it reads nothing, cannot fault and changes no
 /// result).
 #[inline(always)]
@@ -379,8 +395,14 @@ unsafe fn closest_avx2(bvh: &Bvh, ray: &Ray, t_max: f32) -> Option<Hit> {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn closest_each_avx2(bvh: &Bvh, tile: &RayTile, t_max: f32, hits: &mut [Option<Hit>]) {
-    bvh.closest_each::<Avx2>(tile, t_max, hits);
+unsafe fn closest_each_avx2(
+    bvh: &Bvh,
+    tile: &RayTile,
+    t_max: f32,
+    hits: &mut [Option<Hit>],
+    found: impl Fn(u32),
+) {
+    bvh.closest_each::<Avx2>(tile, t_max, hits, found);
 }
 
 #[cfg(target_arch = "x86_64")]

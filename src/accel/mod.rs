@@ -32,6 +32,7 @@ use bvh::Bvh;
 use flat::Flat;
 
 pub use crate::geometry::TILE_RAYS;
+pub(crate) use bvh::prefetch_value;
 pub use flat::TileCache;
 pub use hit::{CULL_SLACK, Hit, cull_bound, shrunk_t_max};
 pub use isa::Isa;
@@ -198,9 +199,23 @@ impl Accel {
         hits: &mut [Option<Hit>],
         cache: &mut TileCache,
     ) {
+        self.intersect_tile_with(tile, t_max, hits, cache, |_| {});
+    }
+
+    /// [`Accel::intersect_tile`], calling `found(triangle)` as soon as a ray's hit is known
+    /// where the structure traces ray by ray (the BVH), so that a caller can prefetch what it
+    /// will read for that hit while the tile's other rays are traced.
+    pub(crate) fn intersect_tile_with(
+        &self,
+        tile: &RayTile,
+        t_max: f32,
+        hits: &mut [Option<Hit>],
+        cache: &mut TileCache,
+        found: impl Fn(u32),
+    ) {
         match &self.structure {
             Structure::Flat(flat) => flat.intersect_tile(self.isa, tile, t_max, hits, cache),
-            Structure::Bvh(bvh) => bvh.intersect_tile(self.isa, tile, t_max, hits),
+            Structure::Bvh(bvh) => bvh.intersect_tile(self.isa, tile, t_max, hits, found),
         }
     }
 

@@ -356,7 +356,15 @@ impl Scene {
         hits: &mut [Option<Hit>],
         cache: &mut TileCache,
     ) {
-        self.accel.intersect_tile(tile, t_max, hits, cache)
+        // Shading reads each hit's triangle, a cache miss in a big scene: ask for it while the
+        // tile's other rays are traced.
+        let triangles = &self.triangles;
+        self.accel
+            .intersect_tile_with(tile, t_max, hits, cache, |i| {
+                if let Some(t) = triangles.get(i as usize) {
+                    crate::accel::prefetch_value(t);
+                }
+            })
     }
 
     /// [`Scene::occluded`] for each of `rays`, into `out` (as many).
