@@ -181,6 +181,16 @@ impl ShadowCull {
     /// [`ShadowCull::kept`] with the margin scaled by `scale` (1 in use; the tests show that
     /// 0 drops triangles the scalar test hits).
     pub(crate) fn kept_with_margin(&self, lo: Vec3, hi: Vec3, scale: f64) -> u64 {
+        #[cfg(target_arch = "x86_64")]
+        let avx = std::is_x86_feature_detected!("avx");
+        #[cfg(not(target_arch = "x86_64"))]
+        let avx = false;
+        self.kept_on(lo, hi, scale, avx)
+    }
+
+    /// [`ShadowCull::kept_with_margin`], the plane tests with AVX (which the CPU must have) or
+    /// portably: the same answer.
+    fn kept_on(&self, lo: Vec3, hi: Vec3, scale: f64, avx: bool) -> u64 {
         let l = self.light.map(f32::from_bits).map(f64::from);
         let (lo, hi) = (lo.to_array().map(f64::from), hi.to_array().map(f64::from));
         // `L − o` over the box: centre and half extent (widened for their rounding), and
@@ -209,16 +219,14 @@ impl ShadowCull {
         let m = scale * (d * de + 6.0 * r * r * (eps * d + TINY) + RHO * self.mag * um);
         let mut neg = [0u64; 3];
         let mut pos = [0u64; 3];
+        #[cfg(target_arch = "x86_64")]
+        if avx {
+            // SAFETY: the caller passes `avx` only where the CPU has it.
+            unsafe { planes_avx(&self.groups, &cu, &ru, m, &mut neg, &mut pos) };
+        }
         for (gi, g) in self.groups.iter().enumerate() {
-            #[cfg(target_arch = "x86_64")]
-            if std::is_x86_feature_detected!("avx") {
-                // SAFETY: the CPU has AVX (checked above).
-                let (n4, p4) = unsafe { planes4_avx(g, &cu, &ru, m) };
-                for p in 0..3 {
-                    neg[p] |= (n4[p] as u64) << (4 * gi);
-                    pos[p] |= (p4[p] as u64) << (4 * gi);
-                }
-                continue;
+            if avx {
+                break;
             }
             for p in 0..3 {
                 let margin = m;
@@ -251,6 +259,7 @@ impl ShadowCull {
 /// The CPU must have AVX.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
+#[inline]
 unsafe fn planes4_avx(g: &Planes4, cu: &[f64; 3], ru: &[f64; 3], m: f64) -> ([u32; 3], [u32; 3]) {
     use std::arch::x86_64::*;
     // SAFETY: each load reads a whole 32-byte-aligned `[f64; 4]`.
@@ -284,6 +293,30 @@ unsafe fn planes4_avx(g: &Planes4, cu: &[f64; 3], ru: &[f64; 3], m: f64) -> ([u3
             _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(_mm256_sub_pd(f, s), margin)) as u32;
     }
     (neg, pos)
+}
+
+/// [`planes4_avx`] for every group, into `neg` and `pos` (bit per triangle).
+///
+/// # Safety
+/// The CPU must have AVX.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+unsafe fn planes_avx(
+    groups: &[Planes4],
+    cu: &[f64; 3],
+    ru: &[f64; 3],
+    m: f64,
+    neg: &mut [u64; 3],
+    pos: &mut [u64; 3],
+) {
+    for (gi, g) in groups.iter().enumerate() {
+        // SAFETY: the CPU has AVX (this function's contract).
+        let (n4, p4) = unsafe { planes4_avx(g, cu, ru, m) };
+        for p in 0..3 {
+            neg[p] |= (n4[p] as u64) << (4 * gi);
+            pos[p] |= (p4[p] as u64) << (4 * gi);
+        }
+    }
 }
 
 impl ShadowCull {
@@ -435,6 +468,13 @@ mod tests {
             let (lo, hi) = (c - h, c + h);
             let cull = ShadowCull::new(&tris, light);
             let kept = cull.kept(lo, hi);
+            #[cfg(target_arch = "x86_64")]
+            if std::is_x86_feature_detected!("avx") {
+                assert_eq!(
+                    cull.kept_on(lo, hi, 1.0, true),
+                    cull.kept_on(lo, hi, 1.0, false)
+                );
+            }
             for (i, t) in tris.iter().enumerate() {
                 total += 1;
                 if kept >> i & 1 == 1 {
