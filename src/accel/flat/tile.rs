@@ -332,8 +332,6 @@ pub(super) fn intersect_tile<K: Cull>(
         }
     }
     for (hits, best) in hits.chunks_mut(8).zip(best.iter()) {
-        for (l, h) in hits.iter_mut().enumerate() {
-            *h = best.hit(l);
-        }
+        best.hits_into(hits, K::AVX2);
     }
 }

@@ -215,6 +215,33 @@ impl Best8 {
         }
     }
 
+    /// The first `out.len()` (at most 8) lanes' closest hits into `out`: each [`Best8::hit`],
+    /// with AVX2 (where `avx2`) gathered lane by lane by a transposition.
+    #[inline(always)]
+    pub(crate) fn hits_into(&self, out: &mut [Option<Hit>], avx2: bool) {
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: the caller passes `avx2` only where the CPU has AVX2.
+            let q = unsafe { x86::best_lanes_avx2(self) };
+            for ((h, &id), &[t, b0, b1, b2]) in out.iter_mut().zip(&self.id).zip(&q) {
+                *h = if id == u32::MAX {
+                    None
+                } else {
+                    Some(Hit {
+                        t,
+                        b: [b0, b1, b2],
+                        triangle: id,
+                    })
+                };
+            }
+            return;
+        }
+        let _ = avx2;
+        for (l, h) in out.iter_mut().enumerate() {
+            *h = self.hit(l);
+        }
+    }
+
     /// Lane `l`'s closest hit.
     #[inline]
     pub fn hit(&self, l: usize) -> Option<Hit> {
@@ -228,6 +255,8 @@ impl Best8 {
 
 /// How a traversal tests blocks: one of the three paths, chosen by the type.
 pub(crate) trait Kernel {
+    /// Whether this is the AVX2 path (its helpers may use AVX2).
+    const AVX2: bool = false;
     /// The hits in one block: `(mask, redo)` as in [`Hits`]; the hit lanes' `t` and
     /// barycentrics into `out` (lanes 0-3).
     fn one(block: &Tri4, ray: &Ray, r: &RayLanes, t_max: f32, out: &mut LaneHits) -> (u32, u32);
@@ -347,6 +376,7 @@ pub(crate) struct Avx2;
 
 #[cfg(target_arch = "x86_64")]
 impl Kernel for Avx2 {
+    const AVX2: bool = true;
     #[inline(always)]
     fn one(block: &Tri4, _: &Ray, r: &RayLanes, t_max: f32, out: &mut LaneHits) -> (u32, u32) {
         // The SSE2 kernel, VEX-encoded where it inlines (functions compiled for AVX2).

@@ -470,9 +470,10 @@ pub unsafe fn rays_avx2(
     best: &mut [Best8],
 ) -> u64 {
     use avx::*;
-    // (A closure: a `target_feature` function is not a `FnMut`.)
-    #[allow(clippy::redundant_closure)]
-    let [[a0, b0, z0], [a1, b1, z1], [a2, b2, z2]] = rel.map(|v| v.map(|x| splat(x)));
+    let [[a0, b0, z0], [a1, b1, z1], [a2, b2, z2]] = rel;
+    let (a0, b0, z0) = (splat(*a0), splat(*b0), splat(*z0));
+    let (a1, b1, z1) = (splat(*a1), splat(*b1), splat(*z1));
+    let (a2, b2, z2) = (splat(*a2), splat(*b2), splat(*z2));
     let t_max = splat(t_max);
     let id = _mm256_castsi256_ps(_mm256_set1_epi32(id as i32));
     let mut redo_all = 0;
@@ -552,4 +553,35 @@ pub fn rays_sse2(
         }
     }
     redo_all
+}
+
+/// Each lane of `best` as `[t, b0, b1, b2]`, by a 4×8 transposition with AVX2.
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[target_feature(enable = "avx2")]
+#[inline]
+pub unsafe fn best_lanes_avx2(best: &Best8) -> [[f32; 4]; 8] {
+    // SAFETY: every load reads a whole 32-byte-aligned `[f32; 8]`; every store writes a whole
+    // `[f32; 4]`.
+    unsafe {
+        let t = _mm256_load_ps(best.t.as_ptr());
+        let [b0, b1, b2] = best.b.each_ref().map(|b| _mm256_load_ps(b.as_ptr()));
+        // Lanes (i, i + 4) of each pair of rows side by side, then in fours.
+        let (tb_lo, tb_hi) = (_mm256_unpacklo_ps(t, b0), _mm256_unpackhi_ps(t, b0));
+        let (bb_lo, bb_hi) = (_mm256_unpacklo_ps(b1, b2), _mm256_unpackhi_ps(b1, b2));
+        let q = [
+            _mm256_shuffle_ps::<0x44>(tb_lo, bb_lo),
+            _mm256_shuffle_ps::<0xee>(tb_lo, bb_lo),
+            _mm256_shuffle_ps::<0x44>(tb_hi, bb_hi),
+            _mm256_shuffle_ps::<0xee>(tb_hi, bb_hi),
+        ];
+        // `q[i]` holds lane i in its low half and lane i + 4 in its high half.
+        let mut out = [[0f32; 4]; 8];
+        for (i, q) in q.into_iter().enumerate() {
+            _mm_storeu_ps(out[i].as_mut_ptr(), _mm256_castps256_ps128(q));
+            _mm_storeu_ps(out[i + 4].as_mut_ptr(), _mm256_extractf128_ps::<1>(q));
+        }
+        out
+    }
 }
