@@ -205,12 +205,19 @@ impl Tracer<'_> {
                 // SAFETY: writes eight `f32`s.
                 unsafe { _mm256_storeu_ps(colour[k].as_mut_ptr(), v) };
             }
-            for l in 0..(m - o).min(8) {
-                let i = s.idx[o + l] as usize;
-                out[i] = Vec3::new(colour[0][l], colour[1][l], colour[2][l]);
-                debug_assert!(out[i].is_finite(), "non-finite colour {}", out[i]);
+            let colour = |l: usize| Vec3::new(colour[0][l], colour[1][l], colour[2][l]);
+            if m - o >= 8 && s.idx[o + 7] == (o + 7) as i32 {
+                // Eight pixels in place (indices only grow): written in a row.
+                for (l, c) in out[o..o + 8].iter_mut().enumerate() {
+                    *c = colour(l);
+                }
+            } else {
+                for l in 0..(m - o).min(8) {
+                    out[s.idx[o + l] as usize] = colour(l);
+                }
             }
         }
+        debug_assert!(out[..k].iter().all(|c| c.is_finite()), "non-finite colour");
     }
 
     /// The tables of [`Tracer::shade_tile_lanes`] for this frame (a small scene).
