@@ -22,6 +22,13 @@ pub const SAH_BINS: usize = 16;
 /// no faster (the issue 11 notes).
 pub const LEAF_MAX: usize = 16;
 
+/// A leaf whose box has more than this fraction of the root box's area holds at most
+/// [`BIG_LEAF_MAX`] triangles (see `choose_split`).
+const BIG_LEAF_AREA: f64 = 1.0 / 16.0;
+
+/// Most triangles of a leaf whose box is big: a quad.
+const BIG_LEAF_MAX: usize = 2;
+
 /// Cost of visiting a node (two slab tests) relative to one triangle test, for the SAH.
 const TRAVERSAL_COST: f64 = 1.0;
 
@@ -89,7 +96,7 @@ pub(super) fn build(triangles: &[Triangle]) -> Built {
             id: i as u32,
         })
         .collect();
-    let (mut root, below, depth) = subtree(&mut refs, 0, 1);
+    let (mut root, below, depth) = subtree(&mut refs, 0, 1, f64::NAN);
     debug_assert!(depth as usize <= MAX_DEPTH);
     if !root.is_leaf() {
         // The root's children are the next pair: flat index 2.
@@ -158,21 +165,26 @@ impl Part {
 /// Builds the subtree over `refs` (whose first entry is at `first` in leaf order) at level
 /// `depth`: its root (an interior root's `offset` is set by the caller), what lies below it,
 /// and the deepest level reached. Halves of large nodes are built in parallel.
-fn subtree(refs: &mut [PrimRef], first: usize, depth: u32) -> (Node, Part, u32) {
+fn subtree(refs: &mut [PrimRef], first: usize, depth: u32, root_area: f64) -> (Node, Part, u32) {
     if refs.len() < PARALLEL_NODE {
         let mut pairs = Vec::with_capacity(refs.len() / 2);
-        let (root, d) = build_node(refs, first, depth, &mut pairs);
+        let (root, d) = build_node(refs, first, depth, root_area, &mut pairs);
         return (root, Part::Pairs(pairs), d);
     }
     let nb = NodeBounds::of(refs);
-    let Some(mid) = split(refs, &nb, depth) else {
+    let root_area = if depth == 1 {
+        nb.bounds.area()
+    } else {
+        root_area
+    };
+    let Some(mid) = split(refs, &nb, depth, root_area) else {
         // (Only nodes of at most LEAF_MAX triangles become leaves.)
         return (leaf(&nb, first, refs.len()), Part::Pairs(Vec::new()), depth);
     };
     let (left, right) = refs.split_at_mut(mid);
     let ((l, l_below, l_depth), (r, r_below, r_depth)) = rayon::join(
-        || subtree(left, first, depth + 1),
-        || subtree(right, first + mid, depth + 1),
+        || subtree(left, first, depth + 1, root_area),
+        || subtree(right, first + mid, depth + 1, root_area),
     );
     let len = 1 + l_below.len() + r_below.len();
     (
@@ -204,32 +216,38 @@ fn interior(nb: &NodeBounds, offset: usize) -> Node {
 
 /// Builds the subtree over `refs` sequentially, appending the pairs below its root to `out`;
 /// returns the root (an interior root's `offset` is its children's index in `out`) and the
-/// deepest level reached.
+/// deepest level reached. `root_area` is the whole tree's box's area (any value at depth 1).
 fn build_node(
     refs: &mut [PrimRef],
     first: usize,
     depth: u32,
+    root_area: f64,
     out: &mut Vec<NodePair>,
 ) -> (Node, u32) {
     let n = refs.len();
     let nb = NodeBounds::of(refs);
-    let Some(mid) = split(refs, &nb, depth) else {
+    let root_area = if depth == 1 {
+        nb.bounds.area()
+    } else {
+        root_area
+    };
+    let Some(mid) = split(refs, &nb, depth, root_area) else {
         return (leaf(&nb, first, n), depth);
     };
     let at = out.len();
     out.push(NodePair([Node::UNUSED; 2]));
     let (left, right) = refs.split_at_mut(mid);
-    let (l, l_depth) = build_node(left, first, depth + 1, out);
-    let (r, r_depth) = build_node(right, first + mid, depth + 1, out);
+    let (l, l_depth) = build_node(left, first, depth + 1, root_area, out);
+    let (r, r_depth) = build_node(right, first + mid, depth + 1, root_area, out);
     out[at] = NodePair([l, r]);
     (interior(&nb, at), l_depth.max(r_depth))
 }
 
 /// Decides how to split the node and reorders `refs` so that the left half comes first;
 /// returns the left half's size, or `None` for a leaf.
-fn split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32) -> Option<usize> {
+fn split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32, root_area: f64) -> Option<usize> {
     let n = refs.len();
-    let mid = match choose_split(refs, nb, depth) {
+    let mid = match choose_split(refs, nb, depth, root_area) {
         Split::Leaf => return None,
         Split::Binned(binning, bin) => {
             partition(refs, |r| binning.bin(r.centroid(binning.axis)) < bin)
@@ -255,8 +273,9 @@ fn split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32) -> Option<usize> {
     Some(mid)
 }
 
-/// Picks how to split a node of `refs.len()` triangles with bounds `nb`.
-fn choose_split(refs: &[PrimRef], nb: &NodeBounds, depth: u32) -> Split {
+/// Picks how to split a node of `refs.len()` triangles with bounds `nb`, in a tree whose root
+/// box has area `root_area`.
+fn choose_split(refs: &[PrimRef], nb: &NodeBounds, depth: u32, root_area: f64) -> Split {
     let n = refs.len();
     if n == 1 {
         return Split::Leaf;
@@ -295,7 +314,12 @@ fn choose_split(refs: &[PrimRef], nb: &NodeBounds, depth: u32) -> Split {
     match (best, split) {
         (Some(cost), Some(split)) if cost.is_finite() && area.is_finite() && area > 0.0 => {
             let split_cost = TRAVERSAL_COST + cost / area;
-            if n <= LEAF_MAX && leaf_cost(n) <= split_cost {
+            // A big box is entered by most rays, before what they hit inside it (the SAH's
+            // estimate, that a ray meeting a box passes through it, misses that), so a leaf
+            // there holds at most a quad: e.g. a room's walls, each its own thin slab that
+            // rays meet only beyond their hit, not one leaf the size of the room.
+            let big = area > BIG_LEAF_AREA * root_area && n > BIG_LEAF_MAX;
+            if n <= LEAF_MAX && leaf_cost(n) <= split_cost && !big {
                 Split::Leaf
             } else {
                 split
