@@ -561,3 +561,65 @@ fn wide_box_tests_agree_on_every_path() {
         }
     }
 }
+
+#[test]
+fn bvh_batches_on_every_path_match_brute_force() {
+    // The BVH answers a tile of camera rays (`Scene::intersect_tile`) and a batch of shadow
+    // rays (`Scene::occluded_each`) with the path picked once for the batch: each answer must
+    // be the brute-force one, on every path, through a tree of many leaves (8000 triangles).
+    let centre = Vec3::splat(0.5);
+    let tris: Vec<[Vec3; 3]> = displaced_icosphere(20, 0.1)
+        .into_iter()
+        .map(|v| v.map(|p| p + centre))
+        .collect();
+    let objects = vec![tris.clone()];
+    let tiles = tiles(31, &tris, 120, 2.0, centre);
+    let scene = scene_of(&objects, AccelKind::Bvh);
+    assert_eq!(scene.accel_stats().kind, AccelKind::Bvh);
+    // (hits, misses, blocked, unblocked): both answers of each kind must come up.
+    let mut seen = [0; 4];
+    for isa in paths() {
+        let s = scene.clone().with_isa(isa).expect("available");
+        let mut cache = TileCache::default();
+        for (i, (tile, t_max)) in tiles.iter().enumerate() {
+            let mut hits = vec![None; tile.len()];
+            s.intersect_tile(tile, *t_max, &mut hits, &mut cache);
+            let rays: Vec<Ray> = (0..tile.len()).map(|r| tile.ray(r)).collect();
+            for h in &hits {
+                seen[usize::from(h.is_none())] += 1;
+            }
+            for (r, got) in hits.iter().enumerate() {
+                let want = brute_force(&tris, &rays[r], *t_max);
+                assert_eq!(
+                    got.map(|h| (h.t.to_bits(), h.b.map(f32::to_bits), h.triangle)),
+                    want.map(|h| (h.t.to_bits(), h.b.map(f32::to_bits), h.triangle)),
+                    "tile {i} ray {r} on {isa:?}"
+                );
+            }
+            // Shadow rays from each hit (or from along the ray) back toward the tile's origin
+            // and beyond it: occluded by the mesh or not.
+            let shadows: Vec<Ray> = rays
+                .iter()
+                .zip(&hits)
+                .map(|(ray, h)| {
+                    let p = ray.at(h.map_or(1.0, |h| h.t * 0.999));
+                    Ray::new(p, tile.origin() - p + Vec3::new(0.3, -0.2, 0.1))
+                })
+                .filter(|r| r.dir != Vec3::ZERO && r.dir.is_finite())
+                .collect();
+            let mut blocked = vec![false; shadows.len()];
+            s.occluded_each(&shadows, 1.0, &mut blocked);
+            for (r, (ray, got)) in shadows.iter().zip(&blocked).enumerate() {
+                let want = tris
+                    .iter()
+                    .any(|v| intersect_watertight(ray, v, 1.0).is_some());
+                assert_eq!(*got, want, "tile {i} shadow ray {r} {ray:?} on {isa:?}");
+                seen[2 + usize::from(!want)] += 1;
+            }
+        }
+    }
+    assert!(
+        seen.iter().all(|&n| n > 100),
+        "(hits, misses, blocked, not) {seen:?}"
+    );
+}
