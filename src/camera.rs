@@ -144,6 +144,7 @@ impl RayGen {
         let mut mixed = false;
         let (mut sx_lo, mut sx_hi) = (splat(f32::INFINITY), splat(f32::NEG_INFINITY));
         let (mut sy_lo, mut sy_hi) = (sx_lo, sx_hi);
+        let (mut sz_lo, mut sz_hi) = (sx_lo, sx_hi);
         for r in 0..rows {
             let dy = splat((((y0 + r) as f32) + 0.5) - self.half_h);
             // `Mat3 * Vec3`: x_axis·d.x + y_axis·d.y + z_axis·d.z, in that order.
@@ -215,6 +216,8 @@ impl RayGen {
             sx_hi = _mm256_max_ps(sx_hi, sx);
             sy_lo = _mm256_min_ps(sy_lo, sy);
             sy_hi = _mm256_max_ps(sy_hi, sy);
+            sz_lo = _mm256_min_ps(sz_lo, sz);
+            sz_hi = _mm256_max_ps(sz_hi, sz);
         }
         out.origin = self.origin;
         out.len = rows * cols;
@@ -239,7 +242,10 @@ impl RayGen {
             fold(sx_hi, f32::max),
             fold(sy_lo, f32::min),
             fold(sy_hi, f32::max),
+            fold(sz_lo, f32::min),
+            fold(sz_hi, f32::max),
         ];
+        out.pad();
     }
 }
 
@@ -294,12 +300,7 @@ mod tests {
                         assert_eq!(t.len(), one.len());
                         assert_eq!(t.origin(), cam.position);
                         assert_eq!(t.axes(), axes.then(|| one[0].axes()));
-                        let mut b = [
-                            f32::INFINITY,
-                            f32::NEG_INFINITY,
-                            f32::INFINITY,
-                            f32::NEG_INFINITY,
-                        ];
+                        let mut b = [f32::INFINITY, f32::NEG_INFINITY].repeat(3);
                         for (j, r) in one.iter().enumerate() {
                             let at = format!("{w}x{h} camera {i}: tile ({x0}, {y0}) ray {j}");
                             let bits = |v: Vec3| v.to_array().map(f32::to_bits);
@@ -315,16 +316,20 @@ mod tests {
                                     r.shear().map(f32::to_bits),
                                     "{at}"
                                 );
-                                b = [
-                                    b[0].min(s[0]),
-                                    b[1].max(s[0]),
-                                    b[2].min(s[1]),
-                                    b[3].max(s[1]),
-                                ];
+                                for k in 0..3 {
+                                    b[2 * k] = b[2 * k].min(s[k]);
+                                    b[2 * k + 1] = b[2 * k + 1].max(s[k]);
+                                }
                             }
                         }
                         if axes {
-                            assert_eq!(t.shear_box(), b, "{w}x{h} camera {i}: ({x0}, {y0})");
+                            assert_eq!(t.shear_box()[..], b, "{w}x{h} camera {i}: ({x0}, {y0})");
+                            // The lanes past the last ray repeat it.
+                            let (n, s) = (t.len(), t.shear_lanes());
+                            for l in n..n.next_multiple_of(8) {
+                                assert_eq!(s[0][l].to_bits(), s[0][n - 1].to_bits());
+                                assert_eq!(s[2][l].to_bits(), s[2][n - 1].to_bits());
+                            }
                         }
                     }
                 }

@@ -4,10 +4,16 @@
 //! light anywhere, on a surface, at a corner, on an edge of a block, inside a block, grazing
 //! a wall; with several lights, mirrors and black surfaces; from cameras all around.
 
+mod common;
+
+use common::{Rng, in_cube, soup, uniform};
 use glam::Vec3;
 use raytty::accel::Isa;
+use raytty::geometry::intersect_watertight;
 use raytty::scene::builtin;
-use raytty::{Camera, Material, PointLight, Scene, SceneBuilder, Stage, cornell_box, render};
+use raytty::{
+    Camera, Material, PointLight, Ray, Scene, SceneBuilder, Stage, Triangle, cornell_box, render,
+};
 
 /// The frame's pixels as bits, and its ray counts.
 fn frame(
@@ -155,4 +161,133 @@ fn several_lights_mirrors_and_black_surfaces_are_the_same_on_every_path() {
         .build("mixed", cornell.camera(), cornell.effects())
         .unwrap();
     assert_paths_agree(&scene, &lights, &Stage::ALL[1..5], "mixed");
+}
+
+/// The shadow-ray kernel and its driver, lane by lane against the scalar test: eight rays
+/// with their own origins toward one light (through vertices and edge midpoints of a soup,
+/// so that edge functions round to zero and lanes are redone in `f64`), every lane's answer
+/// the scalar test's: the kernel's own lanes where it does not hand them back, and the
+/// driver's (cull, "behind" rule, redo) for every lane.
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn shadow_lanes_answer_as_the_scalar_test() {
+    use raytty::accel::shadow::{ShadowCull, ShadowRays8, any_hit8_avx2};
+    if !Isa::Avx2.available() {
+        eprintln!("note: this CPU has no avx2; the shadow lanes are not tested");
+        return;
+    }
+    let t_max = 1.0 - raytty::shading::SHADOW_EPSILON;
+    let (mut hits, mut redos, mut lanes_tested) = (0, 0, 0);
+    let mut rng = Rng::seeded(3);
+    for case in 0..400 {
+        let scale = [1.0, 1e-3, 200.0][case % 3];
+        let tris: Vec<Triangle> = soup(case as u64, 1 + case % 40, 1.0, 0.6, scale)
+            .into_iter()
+            .map(|v| Triangle::new(v[0], v[1], v[2], 0).unwrap())
+            .collect();
+        let light = in_cube(&mut rng, 1.2) * scale;
+        let centre = in_cube(&mut rng, 1.0) * scale;
+        let spread = [0.0, 0.01, 0.3][case % 3] * scale;
+        // Origins around a point, or on the line from the light through a vertex or an edge's
+        // midpoint (the ray then passes through it).
+        let rays: Vec<Ray> = (0..8)
+            .map(|i| {
+                let t = &tris[(rng.next_u64() % tris.len() as u64) as usize];
+                let k = (rng.next_u64() % 3) as usize;
+                let o = match (case + i) % 3 {
+                    0 => centre + in_cube(&mut rng, 1.0) * spread,
+                    1 => light + (t.v[k] - light) * uniform(&mut rng, 1.1, 2.0),
+                    _ => {
+                        let mid = t.v[k] * 0.5 + t.v[(k + 1) % 3] * 0.5;
+                        light + (mid - light) * uniform(&mut rng, 1.1, 2.0)
+                    }
+                };
+                Ray::new(o, light - o)
+            })
+            .filter(|r| r.dir != Vec3::ZERO && r.dir.is_finite())
+            .collect();
+        let cull = ShadowCull::new(&tris, light);
+        // Packets of the rays that share the first one's axes.
+        let mut left: Vec<&Ray> = rays.iter().collect();
+        while let Some(first) = left.first() {
+            let axes = first.axes();
+            let (packet, rest): (Vec<&Ray>, Vec<&Ray>) =
+                left.iter().partition(|r| r.axes() == axes);
+            left = rest;
+            let mut p = ShadowRays8 {
+                axes,
+                ..ShadowRays8::default()
+            };
+            for (l, r) in packet.iter().enumerate() {
+                for (j, &a) in axes.iter().enumerate() {
+                    p.origin[j][l] = r.origin[a];
+                    p.shear[j][l] = r.shear()[j];
+                }
+            }
+            let lanes = (1u32 << packet.len()) - 1;
+            let want: Vec<Vec<bool>> = tris
+                .iter()
+                .map(|t| {
+                    packet
+                        .iter()
+                        .map(|r| intersect_watertight(r, &t.v, t_max).is_some())
+                        .collect()
+                })
+                .collect();
+            for (t, want) in tris.iter().zip(&want) {
+                let v = t.v.map(|v| [v.x, v.y, v.z, 0.0]);
+                // SAFETY: the CPU has AVX2 (checked above).
+                let (hit, redo) = unsafe { any_hit8_avx2(&v, &p, t_max) };
+                for (l, &w) in want.iter().enumerate() {
+                    lanes_tested += 1;
+                    if redo >> l & 1 == 1 {
+                        redos += 1;
+                        continue;
+                    }
+                    hits += w as usize;
+                    assert_eq!(
+                        hit >> l & 1 == 1,
+                        w,
+                        "case {case} lane {l}: {:?} {:?}",
+                        packet[l],
+                        t.v
+                    );
+                }
+            }
+            let (lo, hi) = packet
+                .iter()
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), r| {
+                    (lo.min(r.origin), hi.max(r.origin))
+                });
+            let kz = axes[2];
+            let oz = packet
+                .iter()
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), r| {
+                    (a.min(r.origin[kz]), b.max(r.origin[kz]))
+                });
+            let all = if tris.len() == 64 {
+                u64::MAX
+            } else {
+                (1 << tris.len()) - 1
+            };
+            for kept in [all, cull.kept(lo, hi)] {
+                // SAFETY: as above.
+                let blocked =
+                    unsafe { cull.occluded8_avx2(kept, &p, lanes, oz, t_max, |l| *packet[l]) };
+                for l in 0..packet.len() {
+                    let w = want.iter().any(|w| w[l]);
+                    assert_eq!(
+                        blocked >> l & 1 == 1,
+                        w,
+                        "case {case} lane {l}: {:?}",
+                        packet[l]
+                    );
+                }
+            }
+        }
+    }
+    assert!(
+        hits > 500 && redos > 0,
+        "{hits} hits, {redos} lanes redone of {lanes_tested}"
+    );
 }

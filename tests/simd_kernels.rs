@@ -434,6 +434,67 @@ fn tiles_of_rays_on_every_path_match_brute_force() {
     assert_tiles_agree(&objects, &tiles, "cornell cameras");
 }
 
+/// A `w`×`h` grid of rays from `origin` around `target`, `spacing` apart.
+fn grid(origin: Vec3, target: Vec3, spacing: f32, w: u64, h: u64) -> RayTile {
+    let (u, v) = (target - origin).normalize().any_orthonormal_pair();
+    let rays: Vec<Ray> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x as f32 - w as f32 / 2.0, y as f32 - h as f32 / 2.0)))
+        .map(|(x, y)| target + u * (x * spacing) + v * (y * spacing) - origin)
+        .filter(|d| *d != Vec3::ZERO && d.is_finite())
+        .map(|d| Ray::new(origin, d))
+        .collect();
+    RayTile::from_rays(&rays)
+}
+
+/// Tiles where the watertight test's error bound decides (the tile kernel may skip it only
+/// where `flat/tile.rs` proves it passes; debug builds also assert that on every such
+/// packet): origins just off a triangle's plane (a determinant within its own error), and
+/// triangles whose nearest vertex is a tiny fraction of the farthest's depth, seen from
+/// close to it (a `t` within its error bound).
+#[test]
+fn tiles_near_the_error_bound_match_brute_force() {
+    let mut rng = Rng::seeded(31);
+    for scale in [1e-3, 1.0, 1e3] {
+        let tris = soup(32, 40, 1.0, 0.3, scale);
+        let objects = vec![tris.clone()];
+        let mut tiles = vec![];
+        for i in 0..400 {
+            let t = &tris[(rng.next_u64() % tris.len() as u64) as usize];
+            let k = (rng.next_u64() % 3) as usize;
+            let c = (t[0] + t[1] + t[2]) / 3.0;
+            let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+            let size = (t[k] - c).length();
+            let (origin, target) = if i % 2 == 0 {
+                // Just off the plane, outside the triangle, looking at its middle.
+                let side = c + (t[k] - c) * uniform(&mut rng, 1.5, 4.0);
+                let off = size * log_uniform(&mut rng, -9.0, -2.0);
+                let origin = side + n * if i % 4 == 0 { off } else { -off };
+                (
+                    origin,
+                    c + (t[(k + 1) % 3] - c) * uniform(&mut rng, -0.3, 0.3),
+                )
+            } else {
+                // Close in front of a vertex, looking past it along the triangle.
+                let d = size * log_uniform(&mut rng, -8.0, -2.0);
+                let origin = t[k] + (n * uniform(&mut rng, -1.0, 1.0) - (c - t[k]).normalize()) * d;
+                (
+                    origin,
+                    t[k] + (c - t[k]) * log_uniform(&mut rng, -7.0, -0.3),
+                )
+            };
+            let dist = (target - origin).length();
+            let spacing = dist * log_uniform(&mut rng, -7.0, -1.0);
+            let (w, h) = (1 + rng.next_u64() % 8, 1 + rng.next_u64() % 8);
+            tiles.push((grid(origin, target, spacing, w, h), f32::INFINITY));
+        }
+        assert_tiles_agree(
+            &objects,
+            &tiles,
+            &format!("near the bound at scale {scale}"),
+        );
+    }
+}
+
 #[test]
 fn cornell_frames_are_identical_on_every_path() {
     let scene = cornell_box();

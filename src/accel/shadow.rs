@@ -4,7 +4,7 @@
 //! # The same answers as one ray at a time
 //!
 //! A ray's answer is whether some triangle is accepted by
-//! [`intersect_watertight`] before `t_max` (as [`crate::accel::Accel::occluded`]'s is, see
+//! [`crate::geometry::intersect_watertight`] before `t_max` (as [`crate::accel::Accel::occluded`]'s is, see
 //! [`crate::accel`]): the kernel ([`any_hit8_avx2`]) runs that test's operations lane by lane,
 //! lanes it hands back are redone by the scalar test, and the cull below only drops a triangle
 //! that the scalar test rejects for every ray of the tile.
@@ -50,7 +50,7 @@
 
 use glam::Vec3;
 
-use crate::geometry::{Ray, Triangle, gamma, intersect_watertight};
+use crate::geometry::{Triangle, gamma};
 
 #[cfg(target_arch = "x86_64")]
 pub use super::tri4::shadow::{ShadowRays8, any_hit8_avx2};
@@ -321,7 +321,7 @@ unsafe fn planes_avx(
 
 impl ShadowCull {
     /// Which of `lanes` of `rays` (origins with `o_kz` in `oz`, least and greatest) some kept
-    /// triangle blocks before `t_max`, as [`intersect_watertight`] decides; `ray(l)` is lane
+    /// triangle blocks before `t_max`, as [`crate::geometry::intersect_watertight`] decides; `ray(l)` is lane
     /// `l`'s ray, for the lanes the scalar test redoes.
     ///
     /// # Safety
@@ -335,7 +335,7 @@ impl ShadowCull {
         lanes: u32,
         oz: (f32, f32),
         t_max: f32,
-        ray: impl Fn(usize) -> Ray,
+        ray: impl Fn(usize) -> crate::geometry::Ray,
     ) -> u32 {
         let [kx, _, kz] = rays.axes;
         // `d_kz < 0` exactly when the axes are swapped.
@@ -357,7 +357,7 @@ impl ShadowCull {
             while redo != 0 {
                 let l = redo.trailing_zeros() as usize;
                 redo &= redo - 1;
-                if intersect_watertight(&ray(l), &t.v, t_max).is_some() {
+                if crate::geometry::intersect_watertight(&ray(l), &t.v, t_max).is_some() {
                     blocked |= 1 << l;
                 }
             }
@@ -372,6 +372,7 @@ impl ShadowCull {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::{Ray, intersect_watertight};
     use crate::rng::Rng;
     use crate::shading::SHADOW_EPSILON;
 

@@ -15,7 +15,8 @@ pub const TILE_RAYS: usize = 64;
 /// Ray `i` is `Ray::new(origin, dir(i))`, bit for bit ([`RayTile::ray`]); its shear
 /// (`shear_lanes()[k][i]`, `k` = `sx`, `sy`, `sz`) is that ray's [`Ray::shear`] when every ray
 /// shares one axis order ([`RayTile::axes`] is `Some`), and meaningless otherwise. Lanes from
-/// `len` up to the next multiple of 8 hold something finite or not: readers mask them.
+/// `len` up to the next multiple of 8 repeat ray `len − 1`, so every lane of a packet of eight
+/// is a ray of the tile (inside its box of shears).
 #[derive(Clone, Debug)]
 #[repr(C, align(32))]
 pub struct RayTile {
@@ -24,8 +25,9 @@ pub struct RayTile {
     pub(crate) origin: Vec3,
     pub(crate) len: usize,
     pub(crate) axes: Option<[usize; 3]>,
-    /// The box of the rays' shears: `[min sx, max sx, min sy, max sy]` (when `axes` is some).
-    pub(crate) shear_box: [f32; 4],
+    /// The box of the rays' shears: `[min sx, max sx, min sy, max sy, min sz, max sz]` (when
+    /// `axes` is some).
+    pub(crate) shear_box: [f32; 6],
 }
 
 impl Default for RayTile {
@@ -37,7 +39,7 @@ impl Default for RayTile {
             origin: Vec3::ZERO,
             len: 0,
             axes: None,
-            shear_box: [0.0; 4],
+            shear_box: [0.0; 6],
         }
     }
 }
@@ -62,27 +64,31 @@ impl RayTile {
         let axes = first.axes();
         let common = rays.iter().all(|r| r.axes() == axes);
         tile.axes = common.then_some(axes);
-        let mut b = [
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-        ];
+        let mut b = [f32::INFINITY, f32::NEG_INFINITY].repeat(3);
         for (i, r) in rays.iter().enumerate() {
             let s = r.shear();
             for (k, (d, sh)) in tile.dir.iter_mut().zip(&mut tile.shear).enumerate() {
                 d[i] = r.dir[k];
                 sh[i] = s[k];
+                b[2 * k] = b[2 * k].min(s[k]);
+                b[2 * k + 1] = b[2 * k + 1].max(s[k]);
             }
-            b = [
-                b[0].min(s[0]),
-                b[1].max(s[0]),
-                b[2].min(s[1]),
-                b[3].max(s[1]),
-            ];
         }
-        tile.shear_box = b;
+        tile.shear_box.copy_from_slice(&b);
+        tile.pad();
         tile
+    }
+
+    /// Repeats ray `len − 1` in the lanes up to the next multiple of 8.
+    pub(crate) fn pad(&mut self) {
+        let n = self.len;
+        if n == 0 {
+            return;
+        }
+        for row in self.dir.iter_mut().chain(self.shear.iter_mut()) {
+            let last = row[n - 1];
+            row[n..n.next_multiple_of(8)].fill(last);
+        }
     }
 
     /// How many rays the tile holds.
@@ -135,9 +141,10 @@ impl RayTile {
         &self.shear
     }
 
-    /// `[min sx, max sx, min sy, max sy]` over the rays (when [`RayTile::axes`] is some).
+    /// `[min sx, max sx, min sy, max sy, min sz, max sz]` over the rays (when
+    /// [`RayTile::axes`] is some).
     #[inline]
-    pub fn shear_box(&self) -> [f32; 4] {
+    pub fn shear_box(&self) -> [f32; 6] {
         self.shear_box
     }
 }

@@ -23,6 +23,40 @@
 //! is not finite, a tile whose rays do not share origin and axes) keeps the triangle or falls
 //! back to one ray at a time.
 //!
+//! # Skipping the error bound where it provably passes
+//!
+//! After the sign and range tests, the scalar test accepts a hit only if its determinant's
+//! sign is certain (`|det| > Σ δeᵢ`, the edges' error bounds `EdgeErrors`) and `t` is beyond
+//! its error bound `Δt = 2·(2γ₃·max|zsᵢ| + γ₃·t + W)`, `W` the weights' error
+//! (`t_error_bound`). [`sure`] proves, from a triangle's affine data over the tile, that both
+//! pass for every ray of the tile that passes the sign and range tests; the kernel then skips
+//! computing them (debug builds compute them and assert it on every such packet). With `M` the
+//! sum of the edges' cull margins (each four times the bound on `|eᵢ − exact eᵢ|`, for shears
+//! up to the cache's bound), `D` the least `|c + sx·p + sy·q|` of the determinant's exact
+//! affine form over the shear box (0 if it changes sign), `n`, `f` the nearest and farthest
+//! vertex depth along the rays (`z` in the rays' axis order, its sign flipped when `sz < 0`),
+//! and `s₋`, `s₊` the least and largest `|sz|` of the tile, [`sure`] requires
+//! `D ≥ 2M`, `D ≥ 2⁻⁴⁰`, `n > 0`, `s₋·n ≥ 2⁻⁵⁹`, no overflow (`M`, `M·s₊f` ≤ 2¹⁰⁰), and
+//! `s₋n·(1 − 2⁻²³)(1 − 2⁻¹⁹) > 2.02·(3.01γ₃ + 9M/D)·s₊f·(1 + 2⁻²³)`. Then, for a lane that
+//! passes the sign and range tests (all `eᵢ` of one sign, `u` = 2⁻²⁴):
+//! - The computed `δeᵢ` are sums of non-negative terms, each within `(1 + γ₁₀)` of the cull's
+//!   value at the largest `|x|`, `|y|` the shears allow: `Σ δeᵢ ≤ 0.26·M`. The computed edges
+//!   are within `M/4` of exact in sum, so `|det| ≥ (D − M/4)(1 − u)² ≥ 0.87·D`: the sign is
+//!   certain, and `|det| − Σ δe ≥ 0.7·D`.
+//! - Every `zsᵢ = fl(sz·zᵢ) ≥ m = fl(sz·near) ≥ s₋n(1 − u) > 0`. With all `eᵢ·zsᵢ` of one sign,
+//!   rounding is monotone, each product carries `(1 ± u)` and at most `2⁻¹⁵⁰` absolute (the
+//!   sums add no absolute error), `det ≤ Σeᵢ(1 + u)²`, and `1/det` rounds within 2⁻²²
+//!   relative (subnormal included): `t ≥ m(1 − 2.5·2⁻²²) − 3·2⁻¹⁵⁰/|det| − 2⁻¹⁵⁰`, and with
+//!   `|det| ≥ 2⁻⁴¹`, `m ≥ 2⁻⁶⁰` that is `> m(1 − 2⁻²⁰)`. Likewise `t ≤ 1.01·max|zsᵢ|`.
+//! - Each weight `|bᵢ| ≤ 1.01`, each spread `|zsᵢ − t| + γ₃·max|zs| ≤ 2.03·max|zs|`, so the
+//!   weights' error `W ≤ 4.03·0.26M·2.03·max|zs| / (0.7·D) ≤ 3.1·M·max|zs|/D`, and
+//!   `Δt ≤ 2.001·(3.01γ₃ + 3.1M/D)·max|zs|` with `max|zs| ≤ s₊f(1 + u)`: below the
+//!   condition's right side, which is below `t`.
+//!
+//! `tests/simd_kernels.rs` (`tiles_near_the_error_bound_match_brute_force`: origins just off a
+//! triangle's plane, triangles seen from close to a vertex) fails when either the determinant's
+//! or `t`'s requirement is dropped.
+//!
 //! # Where the work goes
 //!
 //! Per camera ([`TileCache`]): the triangles relative to the origin, their edges' affine
@@ -83,6 +117,12 @@ struct TileTri {
     /// Per edge: the bound on the scalar test's error in `e` for any shear within `bound`
     /// (times four); NaN when not finite (then the triangle is never culled).
     margin: [f64; 3],
+    /// The determinant `Σeᵢ` as `c + sx·p + sy·q` (the edges' coefficients summed), and the
+    /// sum of the edges' margins.
+    det: [f64; 3],
+    det_margin: f64,
+    /// The smallest and largest vertex depth along the rays' main axis (`z`).
+    z_range: (f32, f32),
 }
 
 /// The smallest power of two ≥ `x` (for `x` ≥ 0, finite), so that the margins are rebuilt
@@ -124,8 +164,15 @@ impl TileCache {
                 p: [0.0; 3],
                 q: [0.0; 3],
                 margin: [0.0; 3],
+                det: [0.0; 3],
+                det_margin: 0.0,
+                z_range: (0.0, 0.0),
             };
             edges(&rel, smx, smy, &mut t);
+            t.det = [t.c, t.p, t.q].map(|e| e[0] + e[1] + e[2]);
+            t.det_margin = t.margin[0] + t.margin[1] + t.margin[2];
+            let z = rel.map(|v| v[2]);
+            t.z_range = (z[0].min(z[1]).min(z[2]), z[0].max(z[1]).max(z[2]));
             t
         }));
         self.quads.clear();
@@ -275,6 +322,58 @@ fn may_hit(t: &TileTri, sx: (f64, f64), sy: (f64, f64)) -> bool {
     !(neg && pos)
 }
 
+/// The least `|det|` (over the tile's shears) [`sure`] accepts: keeps underflow out of the
+/// bound on `t` (see the module's doc).
+const DET_MIN: f64 = 1.0 / (1u64 << 40) as f64;
+
+/// The least depth `sz·z` [`sure`] accepts, for the same reason.
+const DEPTH_MIN: f64 = 1.0 / (1u64 << 59) as f64;
+
+/// The largest `Σ margin` and `Σ margin·|sz·z|` [`sure`] accepts: no `f32` overflow in the
+/// error bound's terms.
+const TERM_MAX: f64 = (1u128 << 100) as f64;
+
+/// Whether every ray of a tile (shears in the box `sx` × `sy`, `sz` in `sz`, all of one sign:
+/// positive when `ahead`) that passes triangle `t`'s sign and range tests also passes the
+/// error bound's two (see the module's doc), so that the kernel may skip them.
+#[inline(always)]
+fn sure(t: &TileTri, sx: (f64, f64), sy: (f64, f64), sz: (f32, f32), ahead: bool) -> bool {
+    let (zlo, zhi) = (t.z_range.0 as f64, t.z_range.1 as f64);
+    // Depths along the rays, as positive numbers when in front.
+    let (near, far) = if ahead { (zlo, zhi) } else { (-zhi, -zlo) };
+    let (s_lo, s_hi) = (
+        sz.0.abs().min(sz.1.abs()) as f64,
+        sz.0.abs().max(sz.1.abs()) as f64,
+    );
+    let [c, p, q] = t.det;
+    let (px0, px1, qy0, qy1) = (sx.0 * p, sx.1 * p, sy.0 * q, sy.1 * q);
+    let lo = c + px0.min(px1) + qy0.min(qy1);
+    let hi = c + px0.max(px1) + qy0.max(qy1);
+    let det = if lo > 0.0 {
+        lo
+    } else if hi < 0.0 {
+        -hi
+    } else {
+        0.0
+    };
+    let m = t.det_margin;
+    let (depth_lo, depth_hi) = (s_lo * near * (1.0 - ULP), s_hi * far * (1.0 + ULP));
+    // Every comparison is false on NaN: not sure.
+    let bounded = det >= 2.0 * m
+        && det >= DET_MIN
+        && depth_lo >= DEPTH_MIN
+        && m <= TERM_MAX
+        && m * depth_hi <= TERM_MAX;
+    let delta_t = 2.02 * (3.01 * gamma(3) as f64 + 9.0 * m / det) * depth_hi;
+    bounded && near > 0.0 && depth_lo * (1.0 - T_SHRINK) > delta_t
+}
+
+/// 2⁻²³: more than one rounding of an `f32`, relative.
+const ULP: f64 = 1.0 / (1u64 << 23) as f64;
+
+/// 2⁻¹⁹: how far below the nearest depth a hit's computed `t` can be, relative, with room.
+const T_SHRINK: f64 = 1.0 / (1u64 << 19) as f64;
+
 /// The closest hits of `tile`'s rays into `hits` (as many), each as [`Flat::intersect`] gives
 /// it; a tile whose rays do not share their axes, or a list of too many triangles, is
 /// answered one ray at a time by `one`.
@@ -299,7 +398,7 @@ pub(super) fn intersect_tile<K: Cull>(
         }
     };
     // The box of the tile's shears.
-    let [sx0, sx1, sy0, sy1] = tile.shear_box();
+    let [sx0, sx1, sy0, sy1, sz0, sz1] = tile.shear_box();
     cache.prepare(
         f,
         tile.origin(),
@@ -319,10 +418,13 @@ pub(super) fn intersect_tile<K: Cull>(
     // The triangles that survive the cull, in index order.
     let mut kept = K::kept(cache, sx, sy);
     debug_assert_eq!(kept, cache.kept(sx, sy), "the SIMD cull is the scalar one");
+    // The rays run along +kz when `sz > 0` (one sign for the whole tile: its axes are shared).
+    let ahead = sz0 > 0.0;
     while kept != 0 {
         let t = &cache.tris[kept.trailing_zeros() as usize];
         kept &= kept - 1;
-        let mut redo = K::rays(&t.v, &t.rel, tile, t_max, t.id, best) & lanes;
+        let sure = sure(t, sx, sy, (sz0, sz1), ahead);
+        let mut redo = K::rays(&t.v, &t.rel, tile, t_max, t.id, sure, best) & lanes;
         while redo != 0 {
             let l = redo.trailing_zeros() as usize;
             redo &= redo - 1;

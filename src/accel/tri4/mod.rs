@@ -276,12 +276,17 @@ pub(crate) trait Kernel {
     /// `best` (eight rays each, as many as the tile has packets of eight). Returns the rays
     /// the caller must test with the scalar test (its `f64` redo); bits from `tile.len()` on
     /// are meaningless.
+    ///
+    /// `sure`: the caller has proven that every ray of the tile that passes the test's sign
+    /// and range checks also passes its error-bound checks (`flat/tile.rs`), which the SIMD
+    /// paths then skip.
     fn rays(
         v: &[Vec3; 3],
         rel: &[[f32; 3]; 3],
         tile: &RayTile,
         t_max: f32,
         id: u32,
+        sure: bool,
         best: &mut [Best8],
     ) -> u64;
 }
@@ -318,6 +323,7 @@ impl Kernel for Portable {
         tile: &RayTile,
         t_max: f32,
         id: u32,
+        _: bool,
         best: &mut [Best8],
     ) -> u64 {
         for l in 0..tile.len() {
@@ -363,9 +369,10 @@ impl Kernel for Sse2 {
         tile: &RayTile,
         t_max: f32,
         id: u32,
+        sure: bool,
         best: &mut [Best8],
     ) -> u64 {
-        x86::rays_sse2(rel, tile, t_max, id, best)
+        x86::rays_sse2(rel, tile, t_max, id, sure, best)
     }
 }
 
@@ -406,10 +413,11 @@ impl Kernel for Avx2 {
         tile: &RayTile,
         t_max: f32,
         id: u32,
+        sure: bool,
         best: &mut [Best8],
     ) -> u64 {
         // SAFETY: `Avx2` is only instantiated behind a check that the CPU has AVX2.
-        unsafe { x86::rays_avx2(rel, tile, t_max, id, best) }
+        unsafe { x86::rays_avx2(rel, tile, t_max, id, sure, best) }
     }
 }
 

@@ -1,6 +1,6 @@
 //! Shadow rays eight at a time: one triangle against eight rays that share their axes but not
 //! their origins (a tile's rays toward a point light), any hit only. Each lane runs the
-//! scalar test's operations ([`super::x86`]'s `watertight_lanes`, the kernel of every path)
+//! scalar test's operations (`x86.rs`'s `watertight_lanes`, the kernel of every path)
 //! on its own origin and shear, so a lane is reported hit exactly when
 //! [`crate::geometry::intersect_watertight`] accepts it; a lane whose edge function rounds to
 //! 0 is handed back (`redo`) for the scalar test's `f64` edges.

@@ -50,10 +50,20 @@ macro_rules! triangle_lanes {
 /// `FULL` the mask of all lanes), from each lane's vertices relative to its ray's origin in the
 /// ray's axis order (`a`, `b`, `z` per vertex), its shear and its `t_max`: evaluates to
 /// `(mask, redo, t, b0, b1, b2, accepted)`, `accepted` the hit lanes as a vector mask.
+///
+/// With a fifth argument `sure` (a `bool`) true, the caller has proven that every lane which
+/// passes the sign and range tests also passes `t_error_bound`'s two (the determinant's sign
+/// is certain, `t` is beyond its error bound): they are not computed (debug builds compute
+/// them and assert it).
 macro_rules! watertight_lanes {
     ($o:ident, [$a0:expr, $b0:expr, $z0:expr, $a1:expr, $b1:expr, $z1:expr, $a2:expr, $b2:expr, $z2:expr],
-     [$sx:expr, $sy:expr, $sz:expr], $t_max:expr) => {{
+     [$sx:expr, $sy:expr, $sz:expr], $t_max:expr) => {
+        watertight_lanes!($o, [$a0, $b0, $z0, $a1, $b1, $z1, $a2, $b2, $z2], [$sx, $sy, $sz], $t_max, false)
+    };
+    ($o:ident, [$a0:expr, $b0:expr, $z0:expr, $a1:expr, $b1:expr, $z1:expr, $a2:expr, $b2:expr, $z2:expr],
+     [$sx:expr, $sy:expr, $sz:expr], $t_max:expr, $sure:expr) => {{
         use $o::*;
+        let sure: bool = $sure;
         let (a0, b0, z0, a1, b1, z1, a2, b2, z2) = ($a0, $b0, $z0, $a1, $b1, $z1, $a2, $b2, $z2);
         let (sx, sy, sz) = ($sx, $sy, $sz);
         let t_max = $t_max;
@@ -91,58 +101,65 @@ macro_rules! watertight_lanes {
             let inv_det = div(one, det);
             let t = mul(t_scaled, inv_det);
             let below = lt(t, t_max);
-            // `t_error_bound`.
-            let (g2, g3, g5) = (splat(gamma(2)), splat(gamma(3)), splat(gamma(5)));
-            let two = splat(2.0);
-            let max_zt = max(max(abs(zs0), abs(zs1)), abs(zs2));
-            let (az0, az1, az2) = (abs(z0), abs(z1), abs(z2));
-            let (ax0, ax1, ax2) = (abs(x0), abs(x1), abs(x2));
-            let (ay0, ay1, ay2) = (abs(y0), abs(y1), abs(y2));
-            let dx0 = mul(g5, add(ax0, mul(two, abs(mul(sx, az0)))));
-            let dx1 = mul(g5, add(ax1, mul(two, abs(mul(sx, az1)))));
-            let dx2 = mul(g5, add(ax2, mul(two, abs(mul(sx, az2)))));
-            let dy0 = mul(g5, add(ay0, mul(two, abs(mul(sy, az0)))));
-            let dy1 = mul(g5, add(ay1, mul(two, abs(mul(sy, az1)))));
-            let dy2 = mul(g5, add(ay2, mul(two, abs(mul(sy, az2)))));
-            // `EdgeErrors::new`'s edge(j, k), for (1, 2), (2, 0), (0, 1).
-            let ee0 = add(
-                add(add(add(mul(ax1, dy2), mul(ay2, dx1)), mul(ay1, dx2)), mul(ax2, dy1)),
-                mul(g2, add(abs(p12), abs(p21))),
-            );
-            let ee1 = add(
-                add(add(add(mul(ax2, dy0), mul(ay0, dx2)), mul(ay2, dx0)), mul(ax0, dy2)),
-                mul(g2, add(abs(p20), abs(p02))),
-            );
-            let ee2 = add(
-                add(add(add(mul(ax0, dy1), mul(ay1, dx0)), mul(ay0, dx1)), mul(ax1, dy0)),
-                mul(g2, add(abs(p01), abs(p10))),
-            );
-            // `EdgeErrors::weights`.
-            let total = add(add(ee0, ee1), ee2);
-            let adet = abs(det);
-            let margin = sub(adet, total);
-            let certain = gt(margin, zero);
-            let inv = div(one, adet);
-            let g3z = mul(g3, max_zt);
-            let spread0 = add(abs(sub(zs0, t)), g3z);
-            let spread1 = add(abs(sub(zs1, t)), g3z);
-            let spread2 = add(abs(sub(zs2, t)), g3z);
-            let w0 = mul(add(ee0, mul(abs(mul(e0, inv)), total)), spread0);
-            let w1 = mul(add(ee1, mul(abs(mul(e1, inv)), total)), spread1);
-            let w2 = mul(add(ee2, mul(abs(mul(e2, inv)), total)), spread2);
-            let weights_error = div(add(add(w0, w1), w2), margin);
-            let delta_t = mul(
-                two,
-                add(
-                    add(mul(splat(2.0 * gamma(3)), max_zt), mul(g3, t)),
-                    weights_error,
-                ),
-            );
-            let beyond = gt(t, delta_t);
-            let accepted = andnot(
-                or(reject, any_zero),
-                and(and(below, certain), beyond),
-            );
+            let fast = andnot(or(reject, any_zero), below);
+            let accepted = if sure && !cfg!(debug_assertions) {
+                fast
+            } else {
+                // `t_error_bound`.
+                let (g2, g3, g5) = (splat(gamma(2)), splat(gamma(3)), splat(gamma(5)));
+                let two = splat(2.0);
+                let max_zt = max(max(abs(zs0), abs(zs1)), abs(zs2));
+                let (az0, az1, az2) = (abs(z0), abs(z1), abs(z2));
+                let (ax0, ax1, ax2) = (abs(x0), abs(x1), abs(x2));
+                let (ay0, ay1, ay2) = (abs(y0), abs(y1), abs(y2));
+                let dx0 = mul(g5, add(ax0, mul(two, abs(mul(sx, az0)))));
+                let dx1 = mul(g5, add(ax1, mul(two, abs(mul(sx, az1)))));
+                let dx2 = mul(g5, add(ax2, mul(two, abs(mul(sx, az2)))));
+                let dy0 = mul(g5, add(ay0, mul(two, abs(mul(sy, az0)))));
+                let dy1 = mul(g5, add(ay1, mul(two, abs(mul(sy, az1)))));
+                let dy2 = mul(g5, add(ay2, mul(two, abs(mul(sy, az2)))));
+                // `EdgeErrors::new`'s edge(j, k), for (1, 2), (2, 0), (0, 1).
+                let ee0 = add(
+                    add(add(add(mul(ax1, dy2), mul(ay2, dx1)), mul(ay1, dx2)), mul(ax2, dy1)),
+                    mul(g2, add(abs(p12), abs(p21))),
+                );
+                let ee1 = add(
+                    add(add(add(mul(ax2, dy0), mul(ay0, dx2)), mul(ay2, dx0)), mul(ax0, dy2)),
+                    mul(g2, add(abs(p20), abs(p02))),
+                );
+                let ee2 = add(
+                    add(add(add(mul(ax0, dy1), mul(ay1, dx0)), mul(ay0, dx1)), mul(ax1, dy0)),
+                    mul(g2, add(abs(p01), abs(p10))),
+                );
+                // `EdgeErrors::weights`.
+                let total = add(add(ee0, ee1), ee2);
+                let adet = abs(det);
+                let margin = sub(adet, total);
+                let certain = gt(margin, zero);
+                let inv = div(one, adet);
+                let g3z = mul(g3, max_zt);
+                let spread0 = add(abs(sub(zs0, t)), g3z);
+                let spread1 = add(abs(sub(zs1, t)), g3z);
+                let spread2 = add(abs(sub(zs2, t)), g3z);
+                let w0 = mul(add(ee0, mul(abs(mul(e0, inv)), total)), spread0);
+                let w1 = mul(add(ee1, mul(abs(mul(e1, inv)), total)), spread1);
+                let w2 = mul(add(ee2, mul(abs(mul(e2, inv)), total)), spread2);
+                let weights_error = div(add(add(w0, w1), w2), margin);
+                let delta_t = mul(
+                    two,
+                    add(
+                        add(mul(splat(2.0 * gamma(3)), max_zt), mul(g3, t)),
+                        weights_error,
+                    ),
+                );
+                let beyond = gt(t, delta_t);
+                let full = andnot(
+                    or(reject, any_zero),
+                    and(and(below, certain), beyond),
+                );
+                debug_assert!(!sure || mask(full) == mask(fast), "a sure triangle failed the bound");
+                full
+            };
             (
                 mask(accepted),
                 redo,
@@ -456,7 +473,7 @@ const _: () = assert!(LANES == 4);
 /// order) against `tile`'s rays eight at a time with AVX2, folded into `best` (one per packet
 /// of eight rays: lanes that hit it nearer than their best so far take it, as `id`). Returns
 /// the rays to redo with the scalar test (bits from `tile.len()` on are meaningless). The
-/// triangle's lanes are set up once for all packets.
+/// triangle's lanes are set up once for all packets. `sure`: see [`super::Kernel::rays`].
 ///
 /// # Safety
 /// The CPU must have AVX2.
@@ -467,6 +484,7 @@ pub unsafe fn rays_avx2(
     tile: &RayTile,
     t_max: f32,
     id: u32,
+    sure: bool,
     best: &mut [Best8],
 ) -> u64 {
     use avx::*;
@@ -487,7 +505,8 @@ pub unsafe fn rays_avx2(
             avx,
             [a0, b0, z0, a1, b1, z1, a2, b2, z2],
             [load(&s[0][at..]), load(&s[1][at..]), load(&s[2][at..])],
-            t_max
+            t_max,
+            sure
         );
         redo_all |= (redo as u64) << at;
         if mask != 0 {
@@ -515,6 +534,7 @@ pub fn rays_sse2(
     tile: &RayTile,
     t_max: f32,
     id: u32,
+    sure: bool,
     best: &mut [Best8],
 ) -> u64 {
     use sse::*;
@@ -531,7 +551,8 @@ pub fn rays_sse2(
                 sse,
                 [a0, b0, z0, a1, b1, z1, a2, b2, z2],
                 [load(&s[0][at..]), load(&s[1][at..]), load(&s[2][at..])],
-                t_max
+                t_max,
+                sure
             );
             redo_all |= (redo as u64) << at;
             if mask != 0 {
