@@ -12,6 +12,7 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
+use super::tile::offset_step_avx2;
 use super::{Mode, RayCounts, SHADOW_EPSILON, Tracer};
 use crate::accel::shadow::{SHADOW_TILE_TRIANGLES, ShadowCull, ShadowRays8};
 use crate::accel::{Hit, Isa, TILE_RAYS};
@@ -302,39 +303,12 @@ impl Tracer<'_> {
         let d = add(add(mul(abs(nx), ex), mul(abs(ny), ey)), mul(abs(nz), ez));
         let wn = add(add(mul(tx, nx), mul(ty, ny)), mul(tz, nz));
         let flip = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(wn, zero), sign);
-        let one = _mm256_set1_epi32(1);
         let inf = sp(f32::INFINITY);
-        let step = |v: __m256, off: __m256| {
-            let is_zero = _mm256_cmp_ps::<_CMP_EQ_OQ>(v, zero);
-            let nan = _mm256_cmp_ps::<_CMP_UNORD_Q>(v, v);
-            // `next_float_up`: ±0 → +0, then one step away from −∞; +∞ and NaN stay.
-            let u = _mm256_blendv_ps(v, zero, is_zero);
-            let ub = _mm256_castps_si256(u);
-            let up = _mm256_blendv_ps(
-                _mm256_castsi256_ps(_mm256_sub_epi32(ub, one)),
-                _mm256_castsi256_ps(_mm256_add_epi32(ub, one)),
-                _mm256_cmp_ps::<_CMP_GE_OQ>(u, zero),
-            );
-            let keep = _mm256_or_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(v, inf), nan);
-            let up = _mm256_blendv_ps(up, v, keep);
-            // `next_float_down`: ±0 → −0, then one step toward −∞; −∞ and NaN stay.
-            let w = _mm256_blendv_ps(v, sign, is_zero);
-            let wb = _mm256_castps_si256(w);
-            let down = _mm256_blendv_ps(
-                _mm256_castsi256_ps(_mm256_add_epi32(wb, one)),
-                _mm256_castsi256_ps(_mm256_sub_epi32(wb, one)),
-                _mm256_cmp_ps::<_CMP_GT_OQ>(w, zero),
-            );
-            let keep = _mm256_or_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(v, sp(f32::NEG_INFINITY)), nan);
-            let down = _mm256_blendv_ps(down, v, keep);
-            let v = _mm256_blendv_ps(v, down, _mm256_cmp_ps::<_CMP_LT_OQ>(off, zero));
-            _mm256_blendv_ps(v, up, _mm256_cmp_ps::<_CMP_GT_OQ>(off, zero))
-        };
         let mut nonzero = zero;
         let mut finite = _mm256_cmp_ps::<_CMP_EQ_OQ>(zero, zero);
         for (k, (p, nk)) in [(px, nx), (py, ny), (pz, nz)].into_iter().enumerate() {
             let offset = _mm256_xor_ps(mul(nk, d), flip);
-            let origin = step(add(p, offset), offset);
+            let origin = offset_step_avx2(add(p, offset), offset);
             let dir = sub(sp(lp[k]), origin);
             st(&mut s.origin[k], origin);
             st(&mut s.dir[k], dir);

@@ -85,38 +85,11 @@ impl Tracer<'_> {
         let wn = add(add(mul(tx, nx), mul(ty, ny)), mul(tz, nz));
         let flip = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(wn, zero), sign);
         let offset = [nx, ny, nz].map(|c| _mm256_xor_ps(mul(c, d), flip));
-        let one = _mm256_set1_epi32(1);
         let inf = s(f32::INFINITY);
-        let step = |v: __m256, off: __m256| {
-            let is_zero = _mm256_cmp_ps::<_CMP_EQ_OQ>(v, zero);
-            let nan = _mm256_cmp_ps::<_CMP_UNORD_Q>(v, v);
-            // `next_float_up`: ±0 → +0, then one step away from −∞; +∞ and NaN stay.
-            let u = _mm256_blendv_ps(v, zero, is_zero);
-            let ub = _mm256_castps_si256(u);
-            let up = _mm256_blendv_ps(
-                _mm256_castsi256_ps(_mm256_sub_epi32(ub, one)),
-                _mm256_castsi256_ps(_mm256_add_epi32(ub, one)),
-                _mm256_cmp_ps::<_CMP_GE_OQ>(u, zero),
-            );
-            let keep = _mm256_or_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(v, inf), nan);
-            let up = _mm256_blendv_ps(up, v, keep);
-            // `next_float_down`: ±0 → −0, then one step toward −∞; −∞ and NaN stay.
-            let w = _mm256_blendv_ps(v, sign, is_zero);
-            let wb = _mm256_castps_si256(w);
-            let down = _mm256_blendv_ps(
-                _mm256_castsi256_ps(_mm256_add_epi32(wb, one)),
-                _mm256_castsi256_ps(_mm256_sub_epi32(wb, one)),
-                _mm256_cmp_ps::<_CMP_GT_OQ>(w, zero),
-            );
-            let keep = _mm256_or_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(v, s(f32::NEG_INFINITY)), nan);
-            let down = _mm256_blendv_ps(down, v, keep);
-            let v = _mm256_blendv_ps(v, down, _mm256_cmp_ps::<_CMP_LT_OQ>(off, zero));
-            _mm256_blendv_ps(v, up, _mm256_cmp_ps::<_CMP_GT_OQ>(off, zero))
-        };
         let origin = [
-            step(add(px, offset[0]), offset[0]),
-            step(add(py, offset[1]), offset[1]),
-            step(add(pz, offset[2]), offset[2]),
+            offset_step_avx2(add(px, offset[0]), offset[0]),
+            offset_step_avx2(add(py, offset[1]), offset[1]),
+            offset_step_avx2(add(pz, offset[2]), offset[2]),
         ];
         let dir = [lp.x, lp.y, lp.z]
             .iter()
@@ -155,6 +128,53 @@ impl Tracer<'_> {
             }));
         }
     }
+}
+
+/// The last step of `offset_ray_origin` in eight lanes: each lane of `v` (the point plus its
+/// offset) moved one float up where `off` is positive and one float down where it is
+/// negative, as `next_float_up` and `next_float_down` do it (integer steps on the bits). Only
+/// callable from code compiled for AVX2, where it inlines.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) fn offset_step_avx2(
+    v: std::arch::x86_64::__m256,
+    off: std::arch::x86_64::__m256,
+) -> std::arch::x86_64::__m256 {
+    use std::arch::x86_64::*;
+    let zero = _mm256_setzero_ps();
+    let sign = _mm256_set1_ps(-0.0);
+    let one = _mm256_set1_epi32(1);
+    let is_zero = _mm256_cmp_ps::<_CMP_EQ_OQ>(v, zero);
+    let nan = _mm256_cmp_ps::<_CMP_UNORD_Q>(v, v);
+    // `next_float_up`: ±0 → +0, then one step away from −∞; +∞ and NaN stay.
+    let u = _mm256_blendv_ps(v, zero, is_zero);
+    let ub = _mm256_castps_si256(u);
+    let up = _mm256_blendv_ps(
+        _mm256_castsi256_ps(_mm256_sub_epi32(ub, one)),
+        _mm256_castsi256_ps(_mm256_add_epi32(ub, one)),
+        _mm256_cmp_ps::<_CMP_GE_OQ>(u, zero),
+    );
+    let keep = _mm256_or_ps(
+        _mm256_cmp_ps::<_CMP_EQ_OQ>(v, _mm256_set1_ps(f32::INFINITY)),
+        nan,
+    );
+    let up = _mm256_blendv_ps(up, v, keep);
+    // `next_float_down`: ±0 → −0, then one step toward −∞; −∞ and NaN stay.
+    let w = _mm256_blendv_ps(v, sign, is_zero);
+    let wb = _mm256_castps_si256(w);
+    let down = _mm256_blendv_ps(
+        _mm256_castsi256_ps(_mm256_add_epi32(wb, one)),
+        _mm256_castsi256_ps(_mm256_sub_epi32(wb, one)),
+        _mm256_cmp_ps::<_CMP_GT_OQ>(w, zero),
+    );
+    let keep = _mm256_or_ps(
+        _mm256_cmp_ps::<_CMP_EQ_OQ>(v, _mm256_set1_ps(f32::NEG_INFINITY)),
+        nan,
+    );
+    let down = _mm256_blendv_ps(down, v, keep);
+    let v = _mm256_blendv_ps(v, down, _mm256_cmp_ps::<_CMP_LT_OQ>(off, zero));
+    _mm256_blendv_ps(v, up, _mm256_cmp_ps::<_CMP_GT_OQ>(off, zero))
 }
 
 #[cfg(test)]
