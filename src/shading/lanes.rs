@@ -8,11 +8,10 @@
 //! So every colour and every ray count is the scalar path's, bit for bit.
 
 use std::arch::x86_64::*;
-use std::f32::consts::PI;
 
 use glam::Vec3;
 
-use super::tile::offset_step_avx2;
+use super::tile::light_lanes_avx2;
 use super::{Mode, RayCounts, SHADOW_EPSILON, Tracer};
 use crate::accel::shadow::{SHADOW_TILE_TRIANGLES, ShadowCull, ShadowRays8};
 use crate::accel::{Hit, Isa, TILE_RAYS};
@@ -264,62 +263,19 @@ impl Tracer<'_> {
     fn light_terms8(&self, light: &PointLight, s: &mut LaneScratch, o: usize) -> (u32, u32) {
         let ld = |a: &[f32; N]| unsafe { _mm256_loadu_ps(a[o..].as_ptr()) };
         let st = |a: &mut [f32; N], v: __m256| unsafe { _mm256_storeu_ps(a[o..].as_mut_ptr(), v) };
-        let (px, py, pz) = (ld(&s.p[0]), ld(&s.p[1]), ld(&s.p[2]));
-        let (ex, ey, ez) = (ld(&s.err[0]), ld(&s.err[1]), ld(&s.err[2]));
-        let (nx, ny, nz) = (ld(&s.normal[0]), ld(&s.normal[1]), ld(&s.normal[2]));
-        let sp = |v: f32| _mm256_set1_ps(v);
-        let (add, sub, mul, div) = (
-            |a, b| _mm256_add_ps(a, b),
-            |a, b| _mm256_sub_ps(a, b),
-            |a, b| _mm256_mul_ps(a, b),
-            |a, b| _mm256_div_ps(a, b),
+        let lanes = light_lanes_avx2(
+            light,
+            self.min_r2,
+            s.p.each_ref().map(ld),
+            s.err.each_ref().map(ld),
+            s.normal.each_ref().map(ld),
         );
-        let zero = _mm256_setzero_ps();
-        let sign = sp(-0.0);
-        let abs = |v| _mm256_andnot_ps(sign, v);
-        let lp = light.position;
-        // `to_light`, `length_squared`, `cos`, the term.
-        let (tx, ty, tz) = (sub(sp(lp.x), px), sub(sp(lp.y), py), sub(sp(lp.z), pz));
-        let dist2 = add(add(mul(tx, tx), mul(ty, ty)), mul(tz, tz));
-        let lit = _mm256_cmp_ps::<_CMP_GT_OQ>(dist2, zero);
-        let cos = div(
-            add(add(mul(nx, tx), mul(ny, ty)), mul(nz, tz)),
-            _mm256_sqrt_ps(dist2),
-        );
-        let lit = _mm256_and_ps(lit, _mm256_cmp_ps::<_CMP_GT_OQ>(cos, zero));
-        // `dist2.max(min_r2)`: dist2 > 0 where it matters, never NaN there.
-        let denom = mul(sp(4.0 * PI), _mm256_max_ps(dist2, sp(self.min_r2)));
-        let pw = light.power;
-        let mut term = [div(mul(sp(pw.x), cos), denom); 3];
-        // A white light's three terms are one value (the same operations on the same inputs).
-        if pw.y.to_bits() != pw.x.to_bits() || pw.z.to_bits() != pw.x.to_bits() {
-            term[1] = div(mul(sp(pw.y), cos), denom);
-            term[2] = div(mul(sp(pw.z), cos), denom);
+        for k in 0..3 {
+            st(&mut s.term[k], lanes.term[k]);
+            st(&mut s.origin[k], lanes.origin[k]);
+            st(&mut s.dir[k], lanes.dir[k]);
         }
-        for (k, t) in term.into_iter().enumerate() {
-            st(&mut s.term[k], t);
-        }
-        // `offset_ray_origin(p, err, normal, to_light)`.
-        let d = add(add(mul(abs(nx), ex), mul(abs(ny), ey)), mul(abs(nz), ez));
-        let wn = add(add(mul(tx, nx), mul(ty, ny)), mul(tz, nz));
-        let flip = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(wn, zero), sign);
-        let inf = sp(f32::INFINITY);
-        let mut nonzero = zero;
-        let mut finite = _mm256_cmp_ps::<_CMP_EQ_OQ>(zero, zero);
-        for (k, (p, nk)) in [(px, nx), (py, ny), (pz, nz)].into_iter().enumerate() {
-            let offset = _mm256_xor_ps(mul(nk, d), flip);
-            let origin = offset_step_avx2(add(p, offset), offset);
-            let dir = sub(sp(lp[k]), origin);
-            st(&mut s.origin[k], origin);
-            st(&mut s.dir[k], dir);
-            nonzero = _mm256_or_ps(nonzero, _mm256_cmp_ps::<_CMP_NEQ_UQ>(dir, zero));
-            finite = _mm256_and_ps(finite, _mm256_cmp_ps::<_CMP_LT_OQ>(abs(dir), inf));
-        }
-        let traced = _mm256_and_ps(nonzero, finite);
-        (
-            _mm256_movemask_ps(lit) as u32,
-            _mm256_movemask_ps(traced) as u32,
-        )
+        (lanes.lit, lanes.traced)
     }
 }
 

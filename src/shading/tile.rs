@@ -8,6 +8,8 @@ use glam::Vec3;
 use super::Tracer;
 use crate::geometry::Ray;
 use crate::scene::PointLight;
+#[cfg(target_arch = "x86_64")]
+use std::arch::x86_64::__m256;
 
 /// One pixel being shaded: hit point, its error bound, the normal facing the ray, its index.
 pub(super) type At = (Vec3, Vec3, Vec3, usize);
@@ -40,7 +42,6 @@ impl Tracer<'_> {
     #[target_feature(enable = "avx2")]
     unsafe fn light_terms8_avx2(&self, light: &PointLight, at: &[At], out: &mut Vec<Term>) {
         use std::arch::x86_64::*;
-        use std::f32::consts::PI;
         let n = at.len();
         debug_assert!((1..=8).contains(&n));
         // Lanes past the end repeat the last pixel (never used).
@@ -56,57 +57,14 @@ impl Tracer<'_> {
         // SAFETY: reads eight `f32`s.
         let ld = |a: &[f32; 8]| unsafe { _mm256_loadu_ps(a.as_ptr()) };
         let [px, py, pz, ex, ey, ez, nx, ny, nz] = soa.each_ref().map(ld);
-        let s = |v: f32| _mm256_set1_ps(v);
-        let (add, sub, mul, div) = (
-            |a, b| _mm256_add_ps(a, b),
-            |a, b| _mm256_sub_ps(a, b),
-            |a, b| _mm256_mul_ps(a, b),
-            |a, b| _mm256_div_ps(a, b),
-        );
-        let zero = _mm256_setzero_ps();
-        let sign = s(-0.0);
-        let abs = |v| _mm256_andnot_ps(sign, v);
-        let lp = light.position;
-        // `to_light`, `length_squared`, `cos`, the term.
-        let (tx, ty, tz) = (sub(s(lp.x), px), sub(s(lp.y), py), sub(s(lp.z), pz));
-        let dist2 = add(add(mul(tx, tx), mul(ty, ty)), mul(tz, tz));
-        let lit = _mm256_cmp_ps::<_CMP_GT_OQ>(dist2, zero);
-        let cos = div(
-            add(add(mul(nx, tx), mul(ny, ty)), mul(nz, tz)),
-            _mm256_sqrt_ps(dist2),
-        );
-        let lit = _mm256_and_ps(lit, _mm256_cmp_ps::<_CMP_GT_OQ>(cos, zero));
-        // `dist2.max(min_r2)`: dist2 > 0 where it matters, never NaN there.
-        let denom = mul(s(4.0 * PI), _mm256_max_ps(dist2, s(self.min_r2)));
-        let pw = light.power;
-        let term = [pw.x, pw.y, pw.z].map(|c| div(mul(s(c), cos), denom));
-        // `offset_ray_origin(p, err, normal, to_light)`.
-        let d = add(add(mul(abs(nx), ex), mul(abs(ny), ey)), mul(abs(nz), ez));
-        let wn = add(add(mul(tx, nx), mul(ty, ny)), mul(tz, nz));
-        let flip = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(wn, zero), sign);
-        let offset = [nx, ny, nz].map(|c| _mm256_xor_ps(mul(c, d), flip));
-        let inf = s(f32::INFINITY);
-        let origin = [
-            offset_step_avx2(add(px, offset[0]), offset[0]),
-            offset_step_avx2(add(py, offset[1]), offset[1]),
-            offset_step_avx2(add(pz, offset[2]), offset[2]),
-        ];
-        let dir = [lp.x, lp.y, lp.z]
-            .iter()
-            .zip(&origin)
-            .map(|(&l, &o)| sub(s(l), o))
-            .collect::<Vec<_>>();
-        let any = |f: &dyn Fn(__m256) -> __m256| {
-            _mm256_or_ps(_mm256_or_ps(f(dir[0]), f(dir[1])), f(dir[2]))
-        };
-        let all = |f: &dyn Fn(__m256) -> __m256| {
-            _mm256_and_ps(_mm256_and_ps(f(dir[0]), f(dir[1])), f(dir[2]))
-        };
-        let nonzero = any(&|c| _mm256_cmp_ps::<_CMP_NEQ_UQ>(c, zero));
-        let finite = all(&|c| _mm256_cmp_ps::<_CMP_LT_OQ>(abs(c), inf));
-        let traced = _mm256_and_ps(nonzero, finite);
-        let inv = [0, 1, 2].map(|k| div(s(1.0), dir[k]));
-        let (lit, traced) = (_mm256_movemask_ps(lit), _mm256_movemask_ps(traced));
+        let LightLanes {
+            term,
+            origin,
+            dir,
+            lit,
+            traced,
+        } = light_lanes_avx2(light, self.min_r2, [px, py, pz], [ex, ey, ez], [nx, ny, nz]);
+        let inv = dir.map(|d| _mm256_div_ps(_mm256_set1_ps(1.0), d));
         let store = |v: __m256| {
             let mut a = [0f32; 8];
             // SAFETY: writes eight `f32`s.
@@ -116,7 +74,7 @@ impl Tracer<'_> {
         let (term, origin, dir, inv) = (
             term.map(store),
             origin.map(store),
-            [store(dir[0]), store(dir[1]), store(dir[2])],
+            dir.map(store),
             inv.map(store),
         );
         let v = |a: &[[f32; 8]; 3], l: usize| Vec3::new(a[0][l], a[1][l], a[2][l]);
@@ -130,6 +88,91 @@ impl Tracer<'_> {
     }
 }
 
+/// One light's arithmetic for eight pixels ([`light_lanes_avx2`]).
+#[cfg(target_arch = "x86_64")]
+pub(super) struct LightLanes {
+    /// The unshadowed term per channel.
+    pub term: [__m256; 3],
+    /// The shadow ray's origin (the offset hit point) and direction (to the light).
+    pub origin: [__m256; 3],
+    pub dir: [__m256; 3],
+    /// The lanes lit, and the lanes with a shadow ray to trace (a bit per lane).
+    pub lit: u32,
+    pub traced: u32,
+}
+
+/// [`Tracer::light_term`]'s arithmetic for eight pixels (hit point `p`, its error `err`, the
+/// normal `n` facing the ray, each as x, y, z lanes), the same `f32` operations in the same
+/// order; `min_r2` is the tracer's. Shared by the tile's two shading paths.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) fn light_lanes_avx2(
+    light: &PointLight,
+    min_r2: f32,
+    p: [__m256; 3],
+    err: [__m256; 3],
+    n: [__m256; 3],
+) -> LightLanes {
+    use std::arch::x86_64::*;
+    use std::f32::consts::PI;
+    let [px, py, pz] = p;
+    let [ex, ey, ez] = err;
+    let [nx, ny, nz] = n;
+    let sp = |v: f32| _mm256_set1_ps(v);
+    let (add, sub, mul, div) = (
+        |a, b| _mm256_add_ps(a, b),
+        |a, b| _mm256_sub_ps(a, b),
+        |a, b| _mm256_mul_ps(a, b),
+        |a, b| _mm256_div_ps(a, b),
+    );
+    let zero = _mm256_setzero_ps();
+    let sign = sp(-0.0);
+    let abs = |v| _mm256_andnot_ps(sign, v);
+    let lp = light.position;
+    // `to_light`, `length_squared`, `cos`, the term.
+    let (tx, ty, tz) = (sub(sp(lp.x), px), sub(sp(lp.y), py), sub(sp(lp.z), pz));
+    let dist2 = add(add(mul(tx, tx), mul(ty, ty)), mul(tz, tz));
+    let lit = _mm256_cmp_ps::<_CMP_GT_OQ>(dist2, zero);
+    let cos = div(
+        add(add(mul(nx, tx), mul(ny, ty)), mul(nz, tz)),
+        _mm256_sqrt_ps(dist2),
+    );
+    let lit = _mm256_and_ps(lit, _mm256_cmp_ps::<_CMP_GT_OQ>(cos, zero));
+    // `dist2.max(min_r2)`: dist2 > 0 where it matters, never NaN there.
+    let denom = mul(sp(4.0 * PI), _mm256_max_ps(dist2, sp(min_r2)));
+    let pw = light.power;
+    let mut term = [div(mul(sp(pw.x), cos), denom); 3];
+    // A white light's three terms are one value (the same operations on the same inputs).
+    if pw.y.to_bits() != pw.x.to_bits() || pw.z.to_bits() != pw.x.to_bits() {
+        term[1] = div(mul(sp(pw.y), cos), denom);
+        term[2] = div(mul(sp(pw.z), cos), denom);
+    }
+    // `offset_ray_origin(p, err, normal, to_light)`.
+    let d = add(add(mul(abs(nx), ex), mul(abs(ny), ey)), mul(abs(nz), ez));
+    let wn = add(add(mul(tx, nx), mul(ty, ny)), mul(tz, nz));
+    let flip = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(wn, zero), sign);
+    let inf = sp(f32::INFINITY);
+    let mut nonzero = zero;
+    let mut finite = _mm256_cmp_ps::<_CMP_EQ_OQ>(zero, zero);
+    let mut origin = [zero; 3];
+    let mut dir = [zero; 3];
+    for (k, (p, nk)) in [(px, nx), (py, ny), (pz, nz)].into_iter().enumerate() {
+        let offset = _mm256_xor_ps(mul(nk, d), flip);
+        origin[k] = offset_step_avx2(add(p, offset), offset);
+        dir[k] = sub(sp(lp[k]), origin[k]);
+        nonzero = _mm256_or_ps(nonzero, _mm256_cmp_ps::<_CMP_NEQ_UQ>(dir[k], zero));
+        finite = _mm256_and_ps(finite, _mm256_cmp_ps::<_CMP_LT_OQ>(abs(dir[k]), inf));
+    }
+    LightLanes {
+        term,
+        origin,
+        dir,
+        lit: _mm256_movemask_ps(lit) as u32,
+        traced: _mm256_movemask_ps(_mm256_and_ps(nonzero, finite)) as u32,
+    }
+}
+
 /// The last step of `offset_ray_origin` in eight lanes: each lane of `v` (the point plus its
 /// offset) moved one float up where `off` is positive and one float down where it is
 /// negative, as `next_float_up` and `next_float_down` do it (integer steps on the bits). Only
@@ -137,7 +180,7 @@ impl Tracer<'_> {
 #[cfg(target_arch = "x86_64")]
 #[inline]
 #[target_feature(enable = "avx2")]
-pub(super) fn offset_step_avx2(
+fn offset_step_avx2(
     v: std::arch::x86_64::__m256,
     off: std::arch::x86_64::__m256,
 ) -> std::arch::x86_64::__m256 {
