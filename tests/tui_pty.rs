@@ -630,17 +630,29 @@ fn over_a_slow_link_a_move_is_sent_approximately_then_settles_exact() {
         lights[0].position += camera.to_world(Vec3::new(0.0, 0.0, 1.0) * (0.1 * 1.0));
     }
     let moved = slow_link::app_image(&camera, &lights, cols, rows);
-    // The status line says so while the screen is approximate (for many frames at 60 kB/s).
+    settles_after_approximate(&mut link, &moved, rows, cols, "the link was not measured");
+}
+
+/// Waits until `link`'s screen is `moved` exactly with no `approximate` in the status line
+/// (row `rows - 1`), and asserts that the status line said `approximate` on the way (for many
+/// frames on a slow link); `why` says what its absence means.
+fn settles_after_approximate(
+    link: &mut slow_link::SlowLink,
+    moved: &CellGrid,
+    rows: u16,
+    cols: u16,
+    why: &str,
+) {
     let mut seen_approximate = false;
     let settled = link.wait_for(TIMEOUT, |s| {
         let status = s.contents_between(rows - 1, 0, rows - 1, cols);
         seen_approximate |= status.contains("approximate");
-        slow_link::max_error(s, &moved) == 0 && !status.contains("approximate")
+        slow_link::max_error(s, moved) == 0 && !status.contains("approximate")
     });
     assert!(settled, "the screen never settled on the exact frame");
     assert!(
         seen_approximate,
-        "the move was never shown approximately: the link was not measured"
+        "the move was never shown approximately: {why}"
     );
 }
 
@@ -681,16 +693,12 @@ fn behind_a_deep_buffer_a_terminal_that_answers_paces_the_frames() {
         lights[0].position += step;
     }
     let moved = slow_link::app_image(&camera, &lights, cols, rows);
-    let mut seen_approximate = false;
-    let settled = link.wait_for(TIMEOUT, |s| {
-        let status = s.contents_between(rows - 1, 0, rows - 1, cols);
-        seen_approximate |= status.contains("approximate");
-        slow_link::max_error(s, &moved) == 0 && !status.contains("approximate")
-    });
-    assert!(settled, "the screen never settled on the exact frame");
-    assert!(
-        seen_approximate,
-        "the move was never shown approximately: the answers did not measure the link"
+    settles_after_approximate(
+        &mut link,
+        &moved,
+        rows,
+        cols,
+        "the answers did not measure the link",
     );
     // The answers were consumed as answers: nothing typed reached the app as keys (a reply
     // read as keys would be Esc, `[`, `?`... and Esc quits).
