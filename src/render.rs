@@ -4,6 +4,7 @@
 //! numbers are seeded from (pixel, sample, frame), and the ray counts are integer sums, so the
 //! image and the stats are the same with one thread or many.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
@@ -351,6 +352,7 @@ fn render_impl(
     } else {
         let strata = (samples as f32).sqrt() as u32;
         let square = strata * strata == samples;
+        work_shared_out();
         image
             .pixels
             .par_chunks_mut(w)
@@ -407,6 +409,27 @@ fn render_impl(
     }
 }
 
+/// Set when a frame's work is first shared out: ends [`spin_until_work`].
+static WORK_STARTED: AtomicBool = AtomicBool::new(false);
+
+/// Spins (never sleeps) until the first frame's work is shared out or `limit` has passed.
+///
+/// For a pool's thread just started, from its start handler: a CPU left idle may take
+/// hundreds of microseconds to wake on a virtual machine, and a thread that goes to sleep has
+/// to be woken when the frame starts. A thread that spins is already running when the work
+/// comes. Spinning ties up a CPU, so `limit` should be a few milliseconds.
+pub fn spin_until_work(limit: Duration) {
+    let start = Instant::now();
+    while !WORK_STARTED.load(Ordering::Relaxed) && start.elapsed() < limit {
+        std::hint::spin_loop();
+    }
+}
+
+/// Ends [`spin_until_work`]: called once a frame's work is there for the pool to take.
+fn work_shared_out() {
+    WORK_STARTED.store(true, Ordering::Relaxed);
+}
+
 /// Runs `work` on the calling thread and, at the same time, on as many other threads of the
 /// current rayon pool as there are `units` of work left for them, and sums what they return.
 /// The calling thread starts at once rather than waking the pool and waiting for it; a pool
@@ -414,6 +437,7 @@ fn render_impl(
 /// shares the units out itself. With one unit the pool is not used (nor started).
 fn on_every_thread(units: usize, work: impl Fn() -> RayCounts + Sync) -> RayCounts {
     if units <= 1 {
+        work_shared_out();
         return work();
     }
     let helpers = rayon::current_num_threads().min(units) - 1;
@@ -423,6 +447,7 @@ fn on_every_thread(units: usize, work: impl Fn() -> RayCounts + Sync) -> RayCoun
         for _ in 0..helpers {
             s.spawn(|_| add(work()));
         }
+        work_shared_out();
         add(work());
     });
     total.into_inner().unwrap_or_else(PoisonError::into_inner)
