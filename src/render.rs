@@ -265,7 +265,8 @@ fn render_impl(
         };
         // Bands of `TILE` rows, walked in tiles of `TILE`×`TILE` pixels: each tile's camera
         // rays are traced together (`Scene::intersect_tile`), then shaded. Every thread takes
-        // the next band until none is left, the calling thread too.
+        // the next band until none is left, the calling thread too, from the top and the
+        // others from the bottom (`on_every_thread`).
         let bands = Mutex::new(
             image
                 .pixels
@@ -274,7 +275,7 @@ fn render_impl(
                 .zip(guide_rows.chunks_mut(TILE))
                 .enumerate(),
         );
-        let counts = on_every_thread(h.div_ceil(TILE), || {
+        let counts = on_every_thread(h.div_ceil(TILE), |from_back| {
             let mut n = RayCounts::default();
             let mut tile_rays = RayTile::default();
             let mut tile_hits = [None; TILE_RAYS];
@@ -282,7 +283,14 @@ fn render_impl(
             let mut scratch = TileScratch::default();
             let mut tile_cache = TileCache::default();
             loop {
-                let next = bands.lock().unwrap_or_else(PoisonError::into_inner).next();
+                let next = {
+                    let mut bands = bands.lock().unwrap_or_else(PoisonError::into_inner);
+                    if from_back {
+                        bands.next_back()
+                    } else {
+                        bands.next()
+                    }
+                };
                 let Some((band, ((pixels, hits), guide_rows))) = next else {
                     return n;
                 };
@@ -434,21 +442,24 @@ fn work_shared_out() {
 /// current rayon pool as there are `units` of work left for them, and sums what they return.
 /// The calling thread starts at once rather than waking the pool and waiting for it; a pool
 /// thread joins when it wakes (one that wakes after the work is gone returns at once). `work`
-/// shares the units out itself. With one unit the pool is not used (nor started).
-fn on_every_thread(units: usize, work: impl Fn() -> RayCounts + Sync) -> RayCounts {
+/// shares the units out itself; it is told whether to take them from the back (the pool's
+/// threads) or the front (the calling thread): then the two ends of a new image, each in its
+/// own huge pages, are first touched (and zeroed by the kernel) by different threads at the
+/// same time, not one after the other. With one unit the pool is not used (nor started).
+fn on_every_thread(units: usize, work: impl Fn(bool) -> RayCounts + Sync) -> RayCounts {
     if units <= 1 {
         work_shared_out();
-        return work();
+        return work(false);
     }
     let helpers = rayon::current_num_threads().min(units) - 1;
     let total = Mutex::new(RayCounts::default());
     let add = |n: RayCounts| *total.lock().unwrap_or_else(PoisonError::into_inner) += n;
     rayon::in_place_scope(|s| {
         for _ in 0..helpers {
-            s.spawn(|_| add(work()));
+            s.spawn(|_| add(work(true)));
         }
         work_shared_out();
-        add(work());
+        add(work(false));
     });
     total.into_inner().unwrap_or_else(PoisonError::into_inner)
 }
