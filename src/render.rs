@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use rayon::prelude::*;
 
+use crate::accel::tri4::Best8;
 use crate::accel::{Hit, TILE_RAYS, TileCache};
 use crate::camera::Camera;
 use crate::denoise::{GuidePixel, Guides, denoise};
@@ -224,8 +225,10 @@ fn render_impl(
     // Path-traced frames split every sample for the denoiser (same colour, in any case).
     let split = tracer.splits();
     let draws = tracer.draws_random_numbers();
-    // Frames without path-traced light shade a tile at a time (the same colours).
+    // Frames without path-traced light shade a tile at a time (the same colours), small
+    // scenes on AVX2 straight from the tile kernel's lanes.
     let by_tile = tracer.shades_tiles();
+    let lanes = by_tile && tracer.shades_tile_lanes();
     let mut guides = (guided && split).then(|| Guides {
         width,
         height,
@@ -279,6 +282,7 @@ fn render_impl(
             let mut n = RayCounts::default();
             let mut tile_rays = RayTile::default();
             let mut tile_hits = [None; TILE_RAYS];
+            let mut tile_best = [Best8::NONE; TILE_RAYS / 8];
             let mut tile_colours = [Vec3::ZERO; TILE_RAYS];
             let mut scratch = TileScratch::default();
             let mut tile_cache = TileCache::default();
@@ -301,6 +305,40 @@ fn render_impl(
                     let row = |dy: usize| dy * w + x0..dy * w + x0 + cols;
                     rays.tile(x0, y0, cols, rows, &mut tile_rays);
                     let k = tile_rays.len();
+                    #[cfg(target_arch = "x86_64")]
+                    if lanes {
+                        if !reuse {
+                            n.primary += k as u64;
+                            scene.intersect_tile_best(
+                                &tile_rays,
+                                f32::INFINITY,
+                                &mut tile_best,
+                                &mut tile_cache,
+                            );
+                        }
+                        if let Some(h) = hits.as_deref_mut() {
+                            for i in 0..k {
+                                let at = (i / cols) * w + x0 + i % cols;
+                                if reuse {
+                                    tile_best[i / 8].set(i % 8, h[at]);
+                                } else {
+                                    h[at] = tile_best[i / 8].hit(i % 8);
+                                }
+                            }
+                        }
+                        let colours = &mut tile_colours[..k];
+                        tracer.shade_tile_best(
+                            &tile_rays,
+                            &tile_best,
+                            colours,
+                            &mut n,
+                            &mut scratch,
+                        );
+                        for (dy, tile_row) in colours.chunks_exact(cols).enumerate() {
+                            pixels[row(dy)].copy_from_slice(tile_row);
+                        }
+                        continue;
+                    }
                     if !reuse {
                         n.primary += k as u64;
                         scene.intersect_tile(

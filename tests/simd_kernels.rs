@@ -13,8 +13,8 @@ use common::{Rng, in_cube, log_uniform, soup, uniform, unit};
 use glam::Vec3;
 use raytty::accel::box4::Box4;
 use raytty::accel::box8::Box8;
-use raytty::accel::tri4::{Hits, Tri4, hits as hits_in, hits2};
-use raytty::accel::{Isa, TileCache};
+use raytty::accel::tri4::{Best8, Hits, Tri4, hits as hits_in, hits2};
+use raytty::accel::{Isa, TILE_RAYS, TileCache};
 use raytty::geometry::{Aabb, RayTile, TriHit, intersect_watertight};
 use raytty::scene::procedural::displaced_icosphere;
 use raytty::{
@@ -363,7 +363,8 @@ fn tiles(seed: u64, tris: &[[Vec3; 3]], n: usize, reach: f32, centre: Vec3) -> V
 }
 
 /// `Scene::intersect_tile` on both structures and every path gives each ray of a tile the
-/// brute-force hit, bit for bit (`t`, barycentrics, index), one cache kept across all tiles.
+/// brute-force hit, bit for bit (`t`, barycentrics, index), one cache kept across all tiles;
+/// and `Scene::intersect_tile_best` the same hits in lanes.
 fn assert_tiles_agree(objects: &[Vec<[Vec3; 3]>], tiles: &[(RayTile, f32)], what: &str) {
     let tris: Vec<[Vec3; 3]> = objects.concat();
     for kind in [AccelKind::Flat, AccelKind::Bvh] {
@@ -371,10 +372,19 @@ fn assert_tiles_agree(objects: &[Vec<[Vec3; 3]>], tiles: &[(RayTile, f32)], what
         for isa in paths() {
             let s = scene.clone().with_isa(isa).expect("available");
             let mut cache = TileCache::default();
+            let mut lanes_cache = TileCache::default();
             for (i, (tile, t_max)) in tiles.iter().enumerate() {
                 let mut hits = vec![None; tile.len()];
                 s.intersect_tile(tile, *t_max, &mut hits, &mut cache);
+                let mut best = [Best8::NONE; TILE_RAYS / 8];
+                s.intersect_tile_best(tile, *t_max, &mut best, &mut lanes_cache);
                 for (r, got) in hits.iter().enumerate() {
+                    let lane = best[r / 8].hit(r % 8);
+                    assert_eq!(
+                        got.map(|h| (h.t.to_bits(), h.b.map(f32::to_bits), h.triangle)),
+                        lane.map(|h| (h.t.to_bits(), h.b.map(f32::to_bits), h.triangle)),
+                        "{what}: tile {i} ray {r} in lanes, {kind:?} on {isa:?}"
+                    );
                     let ray = &tile.ray(r);
                     let want = brute_force(&tris, ray, *t_max);
                     assert_eq!(

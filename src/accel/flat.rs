@@ -11,11 +11,11 @@ use super::box4::Box4;
 use super::hit::{Hit, cull_bound};
 use super::isa::Isa;
 use super::tri4::{
-    Closest, Kernel, LANES, Portable, RayLanes, Tri4, blocks_closest, blocks_occluded,
+    Best8, Closest, Kernel, LANES, Portable, RayLanes, Tri4, blocks_closest, blocks_occluded,
 };
 use glam::Vec3;
 
-use crate::geometry::{Aabb, Ray, RayTile, Triangle};
+use crate::geometry::{Aabb, Ray, RayTile, TILE_RAYS, Triangle};
 
 mod tile;
 
@@ -129,6 +129,21 @@ impl Flat {
         }
     }
 
+    /// [`Flat::intersect_tile`] with AVX2 (which the CPU must have), the hits left as the
+    /// kernel makes them: ray `i` is lane `i % 8` of `best[i / 8]`.
+    #[cfg(target_arch = "x86_64")]
+    pub(crate) fn intersect_tile_best_avx2(
+        &self,
+        tile: &RayTile,
+        t_max: f32,
+        best: &mut [Best8; TILE_RAYS / 8],
+        cache: &mut TileCache,
+    ) {
+        assert!(Isa::Avx2.available(), "AVX2 is not available");
+        // SAFETY: checked just above.
+        unsafe { tile_best_avx2(self, tile, t_max, best, cache) }
+    }
+
     /// [`Flat::occluded`] for each of `rays`, into `out` (as many), on path `isa` (must be
     /// available): the path picked once for them all.
     pub fn occluded_each(&self, isa: Isa, rays: &[Ray], t_max: f32, out: &mut [bool]) {
@@ -195,6 +210,20 @@ unsafe fn tile_avx2(
     cache: &mut TileCache,
 ) {
     tile::intersect_tile::<super::tri4::Avx2>(f, tile, t_max, hits, cache, |r| {
+        closest::<super::tri4::Avx2>(f, r, t_max)
+    });
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn tile_best_avx2(
+    f: &Flat,
+    tile: &RayTile,
+    t_max: f32,
+    best: &mut [Best8; TILE_RAYS / 8],
+    cache: &mut TileCache,
+) {
+    tile::intersect_tile_best::<super::tri4::Avx2>(f, tile, t_max, best, cache, |r| {
         closest::<super::tri4::Avx2>(f, r, t_max)
     });
 }

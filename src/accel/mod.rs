@@ -202,6 +202,30 @@ impl Accel {
         self.intersect_tile_with(tile, t_max, hits, cache, |_| {});
     }
 
+    /// [`Accel::intersect_tile`], the hits as lanes: ray `i`'s is lane `i % 8` of
+    /// `best[i / 8]` (lanes past the tile's rays are not to be read). The flat list on AVX2
+    /// leaves them there as its kernel makes them; other structures and paths are asked for
+    /// [`Hit`]s, which are then put in lanes. The same hits either way.
+    pub fn intersect_tile_best(
+        &self,
+        tile: &RayTile,
+        t_max: f32,
+        best: &mut [tri4::Best8; TILE_RAYS / 8],
+        cache: &mut TileCache,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if let (Structure::Flat(flat), Isa::Avx2) = (&self.structure, self.isa) {
+            flat.intersect_tile_best_avx2(tile, t_max, best, cache);
+            return;
+        }
+        let mut hits = [None; TILE_RAYS];
+        let hits = &mut hits[..tile.len()];
+        self.intersect_tile(tile, t_max, hits, cache);
+        for (i, &h) in hits.iter().enumerate() {
+            best[i / 8].set(i % 8, h);
+        }
+    }
+
     /// [`Accel::intersect_tile`], calling `found(triangle)` as soon as a ray's hit is known
     /// where the structure traces ray by ray (the BVH), so that a caller can prefetch what it
     /// will read for that hit while the tile's other rays are traced.

@@ -367,6 +367,18 @@ impl Scene {
             })
     }
 
+    /// [`Scene::intersect_tile`], the hits as lanes ([`crate::accel::Accel::intersect_tile_best`]).
+    #[inline]
+    pub fn intersect_tile_best(
+        &self,
+        tile: &RayTile,
+        t_max: f32,
+        best: &mut [crate::accel::tri4::Best8; crate::accel::TILE_RAYS / 8],
+        cache: &mut TileCache,
+    ) {
+        self.accel.intersect_tile_best(tile, t_max, best, cache)
+    }
+
     /// [`Scene::occluded`] for each of `rays`, into `out` (as many).
     #[inline]
     pub fn occluded_each(&self, rays: &[Ray], t_max: f32, out: &mut [bool]) {

@@ -14,6 +14,7 @@ use glam::Vec3;
 use super::tile::light_lanes_avx2;
 use super::{Mode, RayCounts, SHADOW_EPSILON, Tracer};
 use crate::accel::shadow::{SHADOW_TILE_TRIANGLES, ShadowCull, ShadowRays8};
+use crate::accel::tri4::Best8;
 use crate::accel::{Hit, Isa, TILE_RAYS};
 use crate::geometry::{Ray, RayTile, gamma};
 use crate::scene::{Indirect, PointLight};
@@ -94,9 +95,26 @@ impl Tracer<'_> {
         n: &mut RayCounts,
         s: &mut LaneScratch,
     ) {
-        assert!(self.shades_in_lanes() && rays.len() <= N);
+        let mut best = [Best8::NONE; N / 8];
+        for (i, &h) in hits.iter().enumerate() {
+            best[i / 8].set(i % 8, h);
+        }
+        self.shade_tile_best_lanes(rays, &best, out, n, s);
+    }
+
+    /// [`Tracer::shade_tile_lanes`] of hits in lanes as [`crate::Scene::intersect_tile_best`]
+    /// leaves them (ray `i`'s in lane `i % 8` of `best[i / 8]`).
+    pub(super) fn shade_tile_best_lanes(
+        &self,
+        rays: &RayTile,
+        best: &[Best8; N / 8],
+        out: &mut [Vec3],
+        n: &mut RayCounts,
+        s: &mut LaneScratch,
+    ) {
+        assert!(self.shades_in_lanes() && rays.len() <= N && out.len() == rays.len());
         // SAFETY: the scene's queries take the AVX2 path, which is only set where the CPU has it.
-        unsafe { self.shade_tile_avx2(rays, hits, out, n, s) }
+        unsafe { self.shade_tile_avx2(rays, best, out, n, s) }
     }
 
     #[target_feature(enable = "avx2")]
@@ -104,39 +122,56 @@ impl Tracer<'_> {
     unsafe fn shade_tile_avx2(
         &self,
         rays: &RayTile,
-        hits: &[Option<Hit>],
+        best: &[Best8; N / 8],
         out: &mut [Vec3],
         n: &mut RayCounts,
         s: &mut LaneScratch,
     ) {
         let mode = self.settings.mode;
         let tables = &**self.tables.get_or_init(|| Box::new(self.tables()));
-        // Gather the pixels shaded here; the others are shaded one at a time, after.
+        // Gather the pixels shaded here (packed, in order); the others are shaded one at a
+        // time, after.
         let k = rays.len().min(N);
-        let hits = &hits[..k];
         let mut m = 0;
         let mut others = 0u64;
-        for i in 0..k {
-            let Some(hit) = &hits[i] else {
-                out[i] = Vec3::ZERO;
+        for (c, b) in best.iter().enumerate().take(k.div_ceil(8)) {
+            let (ids, bary) = (b.ids(), b.barycentrics());
+            let lanes = (k - 8 * c).min(8);
+            // Eight hits, all on triangles shaded here (most packets): copied as they are.
+            if lanes == 8 && ids.iter().all(|&id| id < 64 && tables.own >> id & 1 == 1) {
+                for a in 0..3 {
+                    s.bary[a][m..m + 8].copy_from_slice(&bary[a]);
+                }
+                for l in 0..8 {
+                    s.tri[m + l] = ids[l] as i32;
+                    s.idx[m + l] = (8 * c + l) as i32;
+                }
+                m += 8;
                 continue;
-            };
-            let own = tables.own >> hit.triangle & 1;
-            others |= (own ^ 1) << i;
-            // (`m < N`: the mask only tells the compiler so.)
-            let j = m & (N - 1);
-            s.bary[0][j] = hit.b[0];
-            s.bary[1][j] = hit.b[1];
-            s.bary[2][j] = hit.b[2];
-            s.tri[j] = hit.triangle as i32;
-            s.idx[j] = i as i32;
-            m += own as usize;
+            }
+            for l in 0..lanes {
+                let (i, id) = (8 * c + l, ids[l]);
+                if id == u32::MAX {
+                    out[i] = Vec3::ZERO;
+                    continue;
+                }
+                let own = tables.own >> id & 1;
+                others |= (own ^ 1) << i;
+                // (`m < N`: the mask only tells the compiler so.)
+                let j = m & (N - 1);
+                s.bary[0][j] = bary[0][l];
+                s.bary[1][j] = bary[1][l];
+                s.bary[2][j] = bary[2][l];
+                s.tri[j] = id as i32;
+                s.idx[j] = i as i32;
+                m += own as usize;
+            }
         }
         while others != 0 {
             let i = others.trailing_zeros() as usize;
             others &= others - 1;
             let mut rng = crate::rng::Rng::seeded(0);
-            out[i] = self.shade_primary(&rays.ray(i), hits[i], &mut rng, n);
+            out[i] = self.shade_primary(&rays.ray(i), best[i / 8].hit(i % 8), &mut rng, n);
         }
         if m == 0 {
             return;

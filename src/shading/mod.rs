@@ -350,6 +350,29 @@ impl<'a> Tracer<'a> {
         !self.draws_random_numbers()
     }
 
+    /// Whether [`Tracer::shade_tile_best`] shades this frame's tiles (AVX2, a small scene).
+    pub(crate) fn shades_tile_lanes(&self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        return self.shades_in_lanes();
+        #[cfg(not(target_arch = "x86_64"))]
+        false
+    }
+
+    /// [`Tracer::shade_tile`] of hits in lanes as [`crate::Scene::intersect_tile_best`] leaves
+    /// them (ray `i`'s in lane `i % 8` of `best[i / 8]`), without putting them in [`Hit`]s
+    /// first. Only where [`Tracer::shades_tile_lanes`].
+    #[cfg(target_arch = "x86_64")]
+    pub(crate) fn shade_tile_best(
+        &self,
+        rays: &RayTile,
+        best: &[crate::accel::tri4::Best8; crate::accel::TILE_RAYS / 8],
+        out: &mut [Vec3],
+        n: &mut RayCounts,
+        scratch: &mut TileScratch,
+    ) {
+        self.shade_tile_best_lanes(rays, best, out, n, &mut scratch.lanes);
+    }
+
     /// [`Tracer::shade_primary`] for a tile of primary rays and their hits (at most
     /// [`crate::accel::TILE_RAYS`]), into `out`: the same colours bit for bit and the same rays
     /// counted, computed light by light across the tile (each pixel's terms still added in the

@@ -386,13 +386,31 @@ pub(super) fn intersect_tile<K: Cull>(
     cache: &mut TileCache,
     one: impl Fn(&Ray) -> Option<Hit>,
 ) {
+    debug_assert_eq!(tile.len(), hits.len());
+    let mut best = [Best8::NONE; TILE_RAYS / 8];
+    intersect_tile_best::<K>(f, tile, t_max, &mut best, cache, one);
+    for (hits, best) in hits.chunks_mut(8).zip(best.iter()) {
+        best.hits_into(hits, K::AVX2);
+    }
+}
+
+/// [`intersect_tile`], the hits left in `best` as the kernels make them: ray `i` is lane
+/// `i % 8` of `best[i / 8]` (the rest of `best` is left as it was).
+#[inline(always)]
+pub(super) fn intersect_tile_best<K: Cull>(
+    f: &Flat,
+    tile: &RayTile,
+    t_max: f32,
+    best: &mut [Best8; TILE_RAYS / 8],
+    cache: &mut TileCache,
+    one: impl Fn(&Ray) -> Option<Hit>,
+) {
     let n = tile.len();
-    debug_assert_eq!(n, hits.len());
     let axes = match tile.axes() {
         Some(axes) if f.tris.len() <= TILE_TRIANGLES && n > 0 => axes,
         _ => {
-            for (i, h) in hits.iter_mut().enumerate() {
-                *h = one(&tile.ray(i));
+            for i in 0..n {
+                best[i / 8].set(i % 8, one(&tile.ray(i)));
             }
             return;
         }
@@ -413,8 +431,8 @@ pub(super) fn intersect_tile<K: Cull>(
     } else {
         (1 << n) - 1
     };
-    let mut best = [Best8::NONE; TILE_RAYS / 8];
     let best = &mut best[..packets];
+    best.fill(Best8::NONE);
     // The triangles that survive the cull, in index order.
     let mut kept = K::kept(cache, sx, sy);
     debug_assert_eq!(kept, cache.kept(sx, sy), "the SIMD cull is the scalar one");
@@ -432,8 +450,5 @@ pub(super) fn intersect_tile<K: Cull>(
                 best[l / 8].offer(l % 8, h.t, h.b, t.id);
             }
         }
-    }
-    for (hits, best) in hits.chunks_mut(8).zip(best.iter()) {
-        best.hits_into(hits, K::AVX2);
     }
 }

@@ -242,6 +242,39 @@ impl Best8 {
         }
     }
 
+    /// Makes lane `l`'s closest hit `hit` (none: no hit).
+    #[inline]
+    pub fn set(&mut self, l: usize, hit: Option<Hit>) {
+        match hit {
+            Some(h) => {
+                self.t[l] = h.t;
+                for (row, w) in self.b.iter_mut().zip(h.b) {
+                    row[l] = w;
+                }
+                self.id[l] = h.triangle;
+            }
+            None => {
+                self.t[l] = f32::INFINITY;
+                for row in &mut self.b {
+                    row[l] = 0.0;
+                }
+                self.id[l] = u32::MAX;
+            }
+        }
+    }
+
+    /// Each lane's triangle, `u32::MAX` for none.
+    #[inline]
+    pub fn ids(&self) -> &[u32; 2 * LANES] {
+        &self.id
+    }
+
+    /// Each lane's barycentric weights, by vertex (0 where there is no hit).
+    #[inline]
+    pub fn barycentrics(&self) -> &[[f32; 2 * LANES]; 3] {
+        &self.b
+    }
+
     /// Lane `l`'s closest hit.
     #[inline]
     pub fn hit(&self, l: usize) -> Option<Hit> {
