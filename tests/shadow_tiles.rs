@@ -161,6 +161,33 @@ fn several_lights_mirrors_and_black_surfaces_are_the_same_on_every_path() {
         .build("mixed", cornell.camera(), cornell.effects())
         .unwrap();
     assert_paths_agree(&scene, &lights, &Stage::ALL[1..5], "mixed");
+    // Up to the lanes' limit of 64 triangles, so that triangles 32 and on (the high half of
+    // the lanes' bit mask of surfaces shaded in lanes) are seen too: the box, and the box
+    // again at half size inside it, with the materials in turn.
+    let mut b = SceneBuilder::new();
+    let black = b.material(Material::diffuse(Vec3::ZERO));
+    let half = b.material(Material {
+        mirror: 0.5,
+        ..Material::diffuse(Vec3::splat(0.5))
+    });
+    let white = b.material(Material::diffuse(Vec3::splat(0.7)));
+    let red = b.material(Material::diffuse(Vec3::new(0.7, 0.2, 0.2)));
+    let shrunk = cornell.triangles().iter().map(|t| t.v.map(|v| v * 0.5));
+    let all: Vec<[Vec3; 3]> = cornell
+        .triangles()
+        .iter()
+        .map(|t| t.v)
+        .chain(shrunk)
+        .collect();
+    assert_eq!(all.len(), 60);
+    for (i, v) in all.into_iter().enumerate() {
+        b.object([v], [white, black, red, half][i % 4]);
+    }
+    b.light(cornell.lights()[0]);
+    let scene = b
+        .build("sixty", cornell.camera(), cornell.effects())
+        .unwrap();
+    assert_paths_agree(&scene, &lights, &Stage::ALL[1..5], "sixty");
 }
 
 /// The shadow-ray kernel and its driver, lane by lane against the scalar test: eight rays

@@ -134,17 +134,37 @@ impl Tracer<'_> {
         let k = rays.len().min(N);
         let mut m = 0;
         let mut others = 0u64;
+        // `tables.own`'s two halves, and what picks a lane's bit out of them.
+        let own_lo = _mm256_set1_epi32(tables.own as u32 as i32);
+        let own_hi = _mm256_set1_epi32((tables.own >> 32) as u32 as i32);
+        let (one, thirty_two) = (_mm256_set1_epi32(1), _mm256_set1_epi32(32));
+        let iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
         for (c, b) in best.iter().enumerate().take(k.div_ceil(8)) {
             let (ids, bary) = (b.ids(), b.barycentrics());
             let lanes = (k - 8 * c).min(8);
+            // SAFETY: reads eight `u32`s.
+            let id8 = unsafe { _mm256_loadu_si256(ids.as_ptr().cast()) };
+            // Each lane's bit of `own` (0 for a miss, `u32::MAX`): shifts by 32 or more give 0,
+            // so ids below 32 take their bit from the low half, 32..64 from the high one.
+            let bit = _mm256_and_si256(
+                _mm256_or_si256(
+                    _mm256_srlv_epi32(own_lo, id8),
+                    _mm256_srlv_epi32(own_hi, _mm256_sub_epi32(id8, thirty_two)),
+                ),
+                one,
+            );
+            let all_own = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(bit, one)));
             // Eight hits, all on triangles shaded here (most packets): copied as they are.
-            if lanes == 8 && ids.iter().all(|&id| id < 64 && tables.own >> id & 1 == 1) {
+            if lanes == 8 && all_own == 0xff {
                 for a in 0..3 {
                     s.bary[a][m..m + 8].copy_from_slice(&bary[a]);
                 }
-                for l in 0..8 {
-                    s.tri[m + l] = ids[l] as i32;
-                    s.idx[m + l] = (8 * c + l) as i32;
+                let (tri, idx) = (&mut s.tri[m..m + 8], &mut s.idx[m..m + 8]);
+                // SAFETY: each writes eight `i32`s into a slice of eight.
+                unsafe {
+                    _mm256_storeu_si256(tri.as_mut_ptr().cast(), id8);
+                    let at = _mm256_add_epi32(_mm256_set1_epi32(8 * c as i32), iota);
+                    _mm256_storeu_si256(idx.as_mut_ptr().cast(), at);
                 }
                 m += 8;
                 continue;
