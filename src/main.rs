@@ -14,8 +14,8 @@ fn main() -> ExitCode {
     // still sets the total) and no CPU is asked to run two of ours at once. The pool's other
     // threads start now, while this one parses the command line and loads the scene; the
     // first asks the CPU for its features (std caches them; on a VM each CPUID traps, ~30 µs
-    // in all), then they spin until the first frame's work is there, for at most 5 ms, so
-    // they are running when it comes (see `spin_until_work`).
+    // in all), then they wait without sleeping (yielding) until the first frame's work is
+    // there, for at most 5 ms, so they are running when it comes (`spin_until_work`).
     let pool = rayon::ThreadPoolBuilder::new()
         .use_current_thread()
         .start_handler(|i| {

@@ -458,16 +458,20 @@ fn render_impl(
 /// Set when a frame's work is first shared out: ends [`spin_until_work`].
 static WORK_STARTED: AtomicBool = AtomicBool::new(false);
 
-/// Spins (never sleeps) until the first frame's work is shared out or `limit` has passed.
+/// Waits without sleeping (yielding the CPU, never blocking) until the first frame's work is
+/// shared out or `limit` has passed.
 ///
 /// For a pool's thread just started, from its start handler: a CPU left idle may take
 /// hundreds of microseconds to wake on a virtual machine, and a thread that goes to sleep has
-/// to be woken when the frame starts. A thread that spins is already running when the work
-/// comes. Spinning ties up a CPU, so `limit` should be a few milliseconds.
+/// to be woken when the frame starts; a thread that keeps running is there when the work
+/// comes. It yields rather than spins: a new thread is sometimes put on the CPU of the thread
+/// that made it, and there a spinning one would take half of that CPU from the thread that
+/// is getting the frame ready, until the scheduler moves one of them (milliseconds). It
+/// keeps a CPU busy, so `limit` should be a few milliseconds.
 pub fn spin_until_work(limit: Duration) {
     let start = Instant::now();
     while !WORK_STARTED.load(Ordering::Relaxed) && start.elapsed() < limit {
-        std::hint::spin_loop();
+        std::thread::yield_now();
     }
 }
 
