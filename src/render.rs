@@ -305,8 +305,9 @@ fn render_impl(
                     let row = |dy: usize| dy * w + x0..dy * w + x0 + cols;
                     rays.tile(x0, y0, cols, rows, &mut tile_rays);
                     let k = tile_rays.len();
-                    #[cfg(target_arch = "x86_64")]
+                    let colours = &mut tile_colours[..k];
                     if lanes {
+                        // The tile kernel's hits as it leaves them, in lanes, to shading.
                         if !reuse {
                             n.primary += k as u64;
                             scene.intersect_tile_best(
@@ -326,7 +327,6 @@ fn render_impl(
                                 }
                             }
                         }
-                        let colours = &mut tile_colours[..k];
                         tracer.shade_tile_best(
                             &tile_rays,
                             &tile_best,
@@ -334,31 +334,48 @@ fn render_impl(
                             &mut n,
                             &mut scratch,
                         );
-                        for (dy, tile_row) in colours.chunks_exact(cols).enumerate() {
-                            pixels[row(dy)].copy_from_slice(tile_row);
+                    } else {
+                        if !reuse {
+                            n.primary += k as u64;
+                            scene.intersect_tile(
+                                &tile_rays,
+                                f32::INFINITY,
+                                &mut tile_hits[..k],
+                                &mut tile_cache,
+                            );
                         }
-                        continue;
-                    }
-                    if !reuse {
-                        n.primary += k as u64;
-                        scene.intersect_tile(
-                            &tile_rays,
-                            f32::INFINITY,
-                            &mut tile_hits[..k],
-                            &mut tile_cache,
-                        );
-                    }
-                    if let Some(h) = hits {
-                        for (dy, tile_row) in tile_hits[..k].chunks_exact_mut(cols).enumerate() {
-                            if reuse {
-                                tile_row.copy_from_slice(&h[row(dy)]);
-                            } else {
-                                h[row(dy)].copy_from_slice(tile_row);
+                        if let Some(h) = hits.as_deref_mut() {
+                            for (dy, tile_row) in tile_hits[..k].chunks_exact_mut(cols).enumerate()
+                            {
+                                if reuse {
+                                    tile_row.copy_from_slice(&h[row(dy)]);
+                                } else {
+                                    h[row(dy)].copy_from_slice(tile_row);
+                                }
                             }
                         }
-                    }
-                    if by_tile {
-                        let colours = &mut tile_colours[..k];
+                        if !by_tile {
+                            for (i, &hit) in tile_hits[..k].iter().enumerate() {
+                                let ray = &tile_rays.ray(i);
+                                let (dy, x) = (i / cols, x0 + i % cols);
+                                let y = y0 + dy;
+                                // Only path-traced light draws random numbers: skip the hash otherwise.
+                                let mut rng = if draws {
+                                    Stream::for_sample(
+                                        sampler,
+                                        (y * w + x) as u64,
+                                        0,
+                                        1,
+                                        settings.frame,
+                                    )
+                                } else {
+                                    Stream::Independent(Rng::seeded(0))
+                                };
+                                let g = guide_rows[dy].as_mut().map(|r| &mut r[x]);
+                                pixels[dy * w + x] = sample(&tracer, ray, hit, &mut rng, &mut n, g);
+                            }
+                            continue;
+                        }
                         tracer.shade_tile(
                             &tile_rays,
                             &tile_hits[..k],
@@ -366,23 +383,9 @@ fn render_impl(
                             &mut n,
                             &mut scratch,
                         );
-                        for (dy, tile_row) in colours.chunks_exact(cols).enumerate() {
-                            pixels[row(dy)].copy_from_slice(tile_row);
-                        }
-                        continue;
                     }
-                    for (i, &hit) in tile_hits[..k].iter().enumerate() {
-                        let ray = &tile_rays.ray(i);
-                        let (dy, x) = (i / cols, x0 + i % cols);
-                        let y = y0 + dy;
-                        // Only path-traced light draws random numbers: skip the hash otherwise.
-                        let mut rng = if draws {
-                            Stream::for_sample(sampler, (y * w + x) as u64, 0, 1, settings.frame)
-                        } else {
-                            Stream::Independent(Rng::seeded(0))
-                        };
-                        let g = guide_rows[dy].as_mut().map(|r| &mut r[x]);
-                        pixels[dy * w + x] = sample(&tracer, ray, hit, &mut rng, &mut n, g);
+                    for (dy, tile_row) in colours.chunks_exact(cols).enumerate() {
+                        pixels[row(dy)].copy_from_slice(tile_row);
                     }
                 }
                 if let Some(done) = done {

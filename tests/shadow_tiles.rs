@@ -144,50 +144,30 @@ fn several_lights_mirrors_and_black_surfaces_are_the_same_on_every_path() {
         all.push(scene.lights().to_vec());
         assert_paths_agree(&scene, &all, &Stage::ALL[1..5], name);
     }
-    // A box with a black wall and a half mirror.
+    // A box with a black wall and a half mirror; and, up to the lanes' limit of 64
+    // triangles so that triangles 32 and on (the high half of the lanes' bit mask of surfaces
+    // shaded in lanes) are seen too, the box and the box again at half size inside it.
     let cornell = cornell_box();
-    let mut b = SceneBuilder::new();
-    let black = b.material(Material::diffuse(Vec3::ZERO));
-    let half = b.material(Material {
-        mirror: 0.5,
-        ..Material::diffuse(Vec3::splat(0.5))
-    });
-    let white = b.material(Material::diffuse(Vec3::splat(0.7)));
-    for (i, t) in cornell.triangles().iter().enumerate() {
-        b.object([t.v], [black, half, white][i % 3]);
+    let box_tris: Vec<[Vec3; 3]> = cornell.triangles().iter().map(|t| t.v).collect();
+    let shrunk = box_tris.iter().map(|v| v.map(|p| p * 0.5));
+    let sixty: Vec<[Vec3; 3]> = box_tris.iter().copied().chain(shrunk).collect();
+    assert_eq!(sixty.len(), 60);
+    for (name, tris, turns) in [("mixed", box_tris, 3), ("sixty", sixty, 4)] {
+        let mut b = SceneBuilder::new();
+        let black = b.material(Material::diffuse(Vec3::ZERO));
+        let half = b.material(Material {
+            mirror: 0.5,
+            ..Material::diffuse(Vec3::splat(0.5))
+        });
+        let white = b.material(Material::diffuse(Vec3::splat(0.7)));
+        let red = b.material(Material::diffuse(Vec3::new(0.7, 0.2, 0.2)));
+        for (i, v) in tris.into_iter().enumerate() {
+            b.object([v], [black, half, white, red][i % turns]);
+        }
+        b.light(cornell.lights()[0]);
+        let scene = b.build(name, cornell.camera(), cornell.effects()).unwrap();
+        assert_paths_agree(&scene, &lights, &Stage::ALL[1..5], name);
     }
-    b.light(cornell.lights()[0]);
-    let scene = b
-        .build("mixed", cornell.camera(), cornell.effects())
-        .unwrap();
-    assert_paths_agree(&scene, &lights, &Stage::ALL[1..5], "mixed");
-    // Up to the lanes' limit of 64 triangles, so that triangles 32 and on (the high half of
-    // the lanes' bit mask of surfaces shaded in lanes) are seen too: the box, and the box
-    // again at half size inside it, with the materials in turn.
-    let mut b = SceneBuilder::new();
-    let black = b.material(Material::diffuse(Vec3::ZERO));
-    let half = b.material(Material {
-        mirror: 0.5,
-        ..Material::diffuse(Vec3::splat(0.5))
-    });
-    let white = b.material(Material::diffuse(Vec3::splat(0.7)));
-    let red = b.material(Material::diffuse(Vec3::new(0.7, 0.2, 0.2)));
-    let shrunk = cornell.triangles().iter().map(|t| t.v.map(|v| v * 0.5));
-    let all: Vec<[Vec3; 3]> = cornell
-        .triangles()
-        .iter()
-        .map(|t| t.v)
-        .chain(shrunk)
-        .collect();
-    assert_eq!(all.len(), 60);
-    for (i, v) in all.into_iter().enumerate() {
-        b.object([v], [white, black, red, half][i % 4]);
-    }
-    b.light(cornell.lights()[0]);
-    let scene = b
-        .build("sixty", cornell.camera(), cornell.effects())
-        .unwrap();
-    assert_paths_agree(&scene, &lights, &Stage::ALL[1..5], "sixty");
 }
 
 /// The shadow-ray kernel and its driver, lane by lane against the scalar test: eight rays

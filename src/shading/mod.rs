@@ -360,8 +360,8 @@ impl<'a> Tracer<'a> {
 
     /// [`Tracer::shade_tile`] of hits in lanes as [`crate::Scene::intersect_tile_best`] leaves
     /// them (ray `i`'s in lane `i % 8` of `best[i / 8]`), without putting them in [`Hit`]s
-    /// first. Only where [`Tracer::shades_tile_lanes`].
-    #[cfg(target_arch = "x86_64")]
+    /// first. Only where [`Tracer::shades_tile_lanes`] (elsewhere it puts them in `Hit`s for
+    /// [`Tracer::shade_tile`]).
     pub(crate) fn shade_tile_best(
         &self,
         rays: &RayTile,
@@ -370,7 +370,13 @@ impl<'a> Tracer<'a> {
         n: &mut RayCounts,
         scratch: &mut TileScratch,
     ) {
+        #[cfg(target_arch = "x86_64")]
         self.shade_tile_best_lanes(rays, best, out, n, &mut scratch.lanes);
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let hits: Vec<Option<Hit>> = (0..rays.len()).map(|i| best[i / 8].hit(i % 8)).collect();
+            self.shade_tile(rays, &hits, out, n, scratch);
+        }
     }
 
     /// [`Tracer::shade_primary`] for a tile of primary rays and their hits (at most
