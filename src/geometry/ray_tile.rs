@@ -64,7 +64,14 @@ impl RayTile {
         let axes = first.axes();
         let common = rays.iter().all(|r| r.axes() == axes);
         tile.axes = common.then_some(axes);
-        let mut b = [f32::INFINITY, f32::NEG_INFINITY].repeat(3);
+        let mut b = [
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
         for (i, r) in rays.iter().enumerate() {
             let s = r.shear();
             for (k, (d, sh)) in tile.dir.iter_mut().zip(&mut tile.shear).enumerate() {
