@@ -508,8 +508,11 @@ fn tiles_near_the_error_bound_match_brute_force() {
 #[test]
 fn cornell_frames_are_identical_on_every_path() {
     let scene = cornell_box();
-    for stage in Stage::ALL {
-        let settings = stage.settings(scene.effects());
+    // One sample (tiles), and three (anti-aliased: a pass of tiles per sample; path-traced
+    // stages one ray at a time).
+    for (stage, samples) in Stage::ALL.into_iter().flat_map(|s| [(s, 1), (s, 3)]) {
+        let mut settings = stage.settings(scene.effects());
+        settings.effects.samples = samples;
         let frame = |s: &Scene| {
             let f = render(s, &s.camera(), s.lights(), &settings, 96, 64);
             let bits: Vec<u32> = f
@@ -524,7 +527,10 @@ fn cornell_frames_are_identical_on_every_path() {
         for isa in paths() {
             for kind in [AccelKind::Flat, AccelKind::Bvh] {
                 let s = scene.clone().with_accel(kind).with_isa(isa).unwrap();
-                assert!(frame(&s) == want, "{stage:?} differs on {isa:?} {kind:?}");
+                assert!(
+                    frame(&s) == want,
+                    "{stage:?} at {samples} spp differs on {isa:?} {kind:?}"
+                );
             }
         }
     }
