@@ -4,12 +4,17 @@
 //! numbers are seeded from (pixel, sample, frame), and the ray counts are integer sums, so the
 //! image and the stats are the same with one thread or many.
 
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use rayon::prelude::*;
+
+mod samples;
+mod threads;
+
+pub use threads::spin_until_work;
+use threads::{on_every_thread, work_shared_out};
 
 use crate::accel::tri4::Best8;
 use crate::accel::{Hit, TILE_RAYS, TileCache};
@@ -18,7 +23,7 @@ use crate::denoise::{GuidePixel, Guides, denoise};
 use crate::geometry::RayTile;
 use crate::image::Image;
 use crate::rng::Rng;
-use crate::sampler::{SampleSource, Sampler, Stream};
+use crate::sampler::{Sampler, Stream};
 use crate::scene::{PointLight, Scene};
 use crate::shading::{RayCounts, Settings, TileScratch, Tracer};
 
@@ -196,25 +201,6 @@ fn sample(
         g.add(&s);
     }
     s.colour()
-}
-
-/// Where sample `s` of `samples` falls in its pixel (0 to 1 on each axis), stratified: the
-/// sampler's own offset (Sobol points are), else an s×s grid when `samples` is square, else
-/// strata in x. It draws from `rng` what the sample's offset needs.
-fn pixel_offset(rng: &mut Stream, s: u32, samples: u32) -> (f32, f32) {
-    let strata = (samples as f32).sqrt() as u32;
-    let offset = rng.pixel_offset();
-    let [jx, jy] = offset.unwrap_or_else(|| rng.next_2d());
-    if offset.is_some() {
-        (jx, jy)
-    } else if strata * strata == samples {
-        (
-            ((s % strata) as f32 + jx) / strata as f32,
-            ((s / strata) as f32 + jy) / strata as f32,
-        )
-    } else {
-        ((s as f32 + jx) / samples as f32, jy)
-    }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -418,73 +404,18 @@ fn render_impl(
         }
         counts
     } else if by_tile {
-        // Several samples of light that is not path traced (anti-aliasing): per tile, each
-        // sample's camera rays are traced and shaded together, and added to their pixels in
-        // the samples' order, so every pixel gets the sums one ray at a time would give.
-        let bands = Mutex::new(image.pixels.chunks_mut(TILE * w).enumerate());
-        on_every_thread(h.div_ceil(TILE), |from_back| {
-            let mut n = RayCounts::default();
-            let mut tile_rays = Vec::with_capacity(TILE_RAYS);
-            let mut tile_hits = [None; TILE_RAYS];
-            let mut colours = [Vec3::ZERO; TILE_RAYS];
-            let mut sums = [Vec3::ZERO; TILE_RAYS];
-            let mut scratch = TileScratch::default();
-            let mut tile_cache = TileCache::default();
-            loop {
-                let next = {
-                    let mut bands = bands.lock().unwrap_or_else(PoisonError::into_inner);
-                    if from_back {
-                        bands.next_back()
-                    } else {
-                        bands.next()
-                    }
-                };
-                let Some((band, pixels)) = next else {
-                    return n;
-                };
-                let (y0, rows) = (band * TILE, pixels.len() / w);
-                for x0 in (0..w).step_by(TILE) {
-                    let cols = (w - x0).min(TILE);
-                    let k = cols * rows;
-                    sums[..k].fill(Vec3::ZERO);
-                    for s in 0..samples {
-                        tile_rays.clear();
-                        for i in 0..k {
-                            let (x, y) = (x0 + i % cols, y0 + i / cols);
-                            let pixel = (y * w + x) as u64;
-                            let mut rng =
-                                Stream::for_sample(sampler, pixel, s, samples, settings.frame);
-                            let (ox, oy) = pixel_offset(&mut rng, s, samples);
-                            tile_rays.push(rays.ray(x as f32 + ox, y as f32 + oy));
-                        }
-                        let tile = RayTile::from_rays(&tile_rays);
-                        n.primary += k as u64;
-                        scene.intersect_tile(
-                            &tile,
-                            f32::INFINITY,
-                            &mut tile_hits[..k],
-                            &mut tile_cache,
-                        );
-                        tracer.shade_tile(
-                            &tile,
-                            &tile_hits[..k],
-                            &mut colours[..k],
-                            &mut n,
-                            &mut scratch,
-                        );
-                        for (sum, &c) in sums[..k].iter_mut().zip(&colours[..k]) {
-                            *sum += c;
-                        }
-                    }
-                    for (i, sum) in sums[..k].iter().enumerate() {
-                        pixels[(i / cols) * w + x0 + i % cols] = *sum / samples as f32;
-                    }
-                }
-                if let Some(done) = done {
-                    done(y0 as u32, pixels);
-                }
-            }
-        })
+        // Several samples of light that is not path traced (anti-aliasing): a pass of tiles
+        // per sample.
+        samples::by_tile(
+            &mut image.pixels,
+            w,
+            samples,
+            settings.frame,
+            &rays,
+            scene,
+            &tracer,
+            done,
+        )
     } else {
         work_shared_out();
         image
@@ -500,7 +431,7 @@ fn render_impl(
                         let pixel = (y * w + x) as u64;
                         let mut rng =
                             Stream::for_sample(sampler, pixel, s, samples, settings.frame);
-                        let (ox, oy) = pixel_offset(&mut rng, s, samples);
+                        let (ox, oy) = samples::pixel_offset(&mut rng, s, samples);
                         let ray = rays.ray(x as f32 + ox, y as f32 + oy);
                         n.primary += 1;
                         let hit = scene.intersect(&ray, f32::INFINITY);
@@ -528,57 +459,6 @@ fn render_impl(
         },
         guides,
     }
-}
-
-/// Set when a frame's work is first shared out: ends [`spin_until_work`].
-static WORK_STARTED: AtomicBool = AtomicBool::new(false);
-
-/// Waits without sleeping (yielding the CPU, never blocking) until the first frame's work is
-/// shared out or `limit` has passed.
-///
-/// For a pool's thread just started, from its start handler: a CPU left idle may take
-/// hundreds of microseconds to wake on a virtual machine, and a thread that goes to sleep has
-/// to be woken when the frame starts; a thread that keeps running is there when the work
-/// comes. It yields rather than spins: a new thread is sometimes put on the CPU of the thread
-/// that made it, and there a spinning one would take half of that CPU from the thread that
-/// is getting the frame ready, until the scheduler moves one of them (milliseconds). It
-/// keeps a CPU busy, so `limit` should be a few milliseconds.
-pub fn spin_until_work(limit: Duration) {
-    let start = Instant::now();
-    while !WORK_STARTED.load(Ordering::Relaxed) && start.elapsed() < limit {
-        std::thread::yield_now();
-    }
-}
-
-/// Ends [`spin_until_work`]: called once a frame's work is there for the pool to take.
-fn work_shared_out() {
-    WORK_STARTED.store(true, Ordering::Relaxed);
-}
-
-/// Runs `work` on the calling thread and, at the same time, on as many other threads of the
-/// current rayon pool as there are `units` of work left for them, and sums what they return.
-/// The calling thread starts at once rather than waking the pool and waiting for it; a pool
-/// thread joins when it wakes (one that wakes after the work is gone returns at once). `work`
-/// shares the units out itself; it is told whether to take them from the back (the pool's
-/// threads) or the front (the calling thread): then the two ends of a new image, each in its
-/// own huge pages, are first touched (and zeroed by the kernel) by different threads at the
-/// same time, not one after the other. With one unit the pool is not used (nor started).
-fn on_every_thread(units: usize, work: impl Fn(bool) -> RayCounts + Sync) -> RayCounts {
-    if units <= 1 {
-        work_shared_out();
-        return work(false);
-    }
-    let helpers = rayon::current_num_threads().min(units) - 1;
-    let total = Mutex::new(RayCounts::default());
-    let add = |n: RayCounts| *total.lock().unwrap_or_else(PoisonError::into_inner) += n;
-    rayon::in_place_scope(|s| {
-        for _ in 0..helpers {
-            s.spawn(|_| add(work(true)));
-        }
-        work_shared_out();
-        add(work(false));
-    });
-    total.into_inner().unwrap_or_else(PoisonError::into_inner)
 }
 
 fn sum(mut a: RayCounts, b: RayCounts) -> RayCounts {
