@@ -4,7 +4,7 @@
 //! numbers are seeded from (pixel, sample, frame), and the ray counts are integer sums, so the
 //! image and the stats are the same with one thread or many.
 
-use std::sync::{Mutex, PoisonError};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
@@ -14,7 +14,7 @@ mod samples;
 mod threads;
 
 pub use threads::spin_until_work;
-use threads::{on_every_thread, work_shared_out};
+use threads::{next_band, on_every_thread, work_shared_out};
 
 use crate::accel::tri4::Best8;
 use crate::accel::{Hit, TILE_RAYS, TileCache};
@@ -292,14 +292,7 @@ fn render_impl(
             let mut scratch = TileScratch::default();
             let mut tile_cache = TileCache::default();
             loop {
-                let next = {
-                    let mut bands = bands.lock().unwrap_or_else(PoisonError::into_inner);
-                    if from_back {
-                        bands.next_back()
-                    } else {
-                        bands.next()
-                    }
-                };
+                let next = next_band(&bands, from_back);
                 let Some((band, ((pixels, hits), guide_rows))) = next else {
                     return n;
                 };

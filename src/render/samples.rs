@@ -1,10 +1,10 @@
 //! Anti-aliased frames whose light is not path traced: a pass of tiles per sample.
 
-use std::sync::{Mutex, PoisonError};
+use std::sync::Mutex;
 
 use glam::Vec3;
 
-use super::threads::on_every_thread;
+use super::threads::{next_band, on_every_thread};
 use super::{BandDone, TILE};
 use crate::accel::{TILE_RAYS, TileCache};
 use crate::camera::RayGen;
@@ -61,14 +61,7 @@ pub(super) fn by_tile(
         let mut scratch = TileScratch::default();
         let mut tile_cache = TileCache::default();
         loop {
-            let next = {
-                let mut bands = bands.lock().unwrap_or_else(PoisonError::into_inner);
-                if from_back {
-                    bands.next_back()
-                } else {
-                    bands.next()
-                }
-            };
+            let next = next_band(&bands, from_back);
             let Some((band, pixels)) = next else {
                 return n;
             };

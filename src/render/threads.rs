@@ -57,3 +57,17 @@ pub(super) fn on_every_thread(units: usize, work: impl Fn(bool) -> RayCounts + S
     });
     total.into_inner().unwrap_or_else(PoisonError::into_inner)
 }
+
+/// The next unit of `units` (a frame's bands) for a thread of [`on_every_thread`]: from the
+/// back for the pool's threads, from the front for the calling thread.
+pub(super) fn next_band<I: DoubleEndedIterator>(
+    units: &Mutex<I>,
+    from_back: bool,
+) -> Option<I::Item> {
+    let mut units = units.lock().unwrap_or_else(PoisonError::into_inner);
+    if from_back {
+        units.next_back()
+    } else {
+        units.next()
+    }
+}
