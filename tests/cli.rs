@@ -555,3 +555,19 @@ fn color_picks_the_text_format_of_render() {
     );
     let _ = std::fs::remove_file(&png);
 }
+
+/// `--help` and `help` end with the app's keys (built only when help is asked for); `-h`, the
+/// short help, does not list them.
+#[cfg(feature = "tui")]
+#[test]
+fn long_help_lists_the_app_keys() {
+    for args in [&["--help"][..], &["help"][..]] {
+        let out = raytty(args);
+        assert!(out.status.success(), "{args:?}");
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("Keys in the app:"), "{args:?}: {text}");
+        assert!(text.contains("Esc, Ctrl-C"), "{args:?}: {text}");
+    }
+    let short = raytty(&["-h"]);
+    assert!(!String::from_utf8_lossy(&short.stdout).contains("Keys in the app:"));
+}

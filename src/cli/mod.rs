@@ -27,7 +27,11 @@ use render::{RenderColor, run_render, text_format, without_os_error};
 pub fn main() -> ExitCode {
     #[allow(unused_mut)]
     let mut cmd = Cli::command();
+    // The app's keys, under `--help` (and `help`): built only when asked for.
     #[cfg(feature = "tui")]
+    if std::env::args_os()
+        .skip(1)
+        .any(|a| a == "--help" || a == "help")
     {
         cmd = cmd.after_long_help(crate::tui::keys::help_text());
     }
