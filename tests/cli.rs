@@ -571,3 +571,62 @@ fn long_help_lists_the_app_keys() {
     let short = raytty(&["-h"]);
     assert!(!String::from_utf8_lossy(&short.stdout).contains("Keys in the app:"));
 }
+
+/// Without `RAYON_NUM_THREADS`, a frame runs on as many threads as the CPUs the process may run
+/// on (its affinity mask, as `nproc` counts: the binary reads the mask itself rather than
+/// rayon's default), here one CPU and all of them; with it, on as many as it says.
+#[cfg(target_os = "linux")]
+#[test]
+fn the_pool_has_a_thread_per_cpu_of_the_affinity_mask() {
+    use std::os::unix::process::CommandExt;
+    // SAFETY: a zeroed `cpu_set_t` is valid; the kernel writes the calling thread's mask.
+    let all = unsafe {
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        assert_eq!(libc::sched_getaffinity(0, size_of_val(&set), &mut set), 0);
+        set
+    };
+    // SAFETY: reads the set.
+    let cpus = unsafe { libc::CPU_COUNT(&all) } as usize;
+    let first = (0..libc::CPU_SETSIZE as usize)
+        // SAFETY: reads the set.
+        .find(|&c| unsafe { libc::CPU_ISSET(c, &all) })
+        .unwrap();
+    let threads = |one_cpu: bool, env: Option<&str>| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_raytty"));
+        cmd.args([
+            "render", "--pixels", "64x64", "--format", "ascii", "--stats",
+        ])
+        .env_remove("RAYON_NUM_THREADS");
+        if let Some(n) = env {
+            cmd.env("RAYON_NUM_THREADS", n);
+        }
+        if one_cpu {
+            // SAFETY: between fork and exec only `sched_setaffinity`, async-signal-safe, runs.
+            unsafe {
+                cmd.pre_exec(move || {
+                    let mut set: libc::cpu_set_t = std::mem::zeroed();
+                    libc::CPU_SET(first, &mut set);
+                    libc::sched_setaffinity(0, size_of_val(&set), &set);
+                    Ok(())
+                });
+            }
+        }
+        let out = cmd.output().unwrap();
+        assert!(out.status.success());
+        let err = String::from_utf8(out.stderr).unwrap();
+        let n = err
+            .rsplit(", ")
+            .next()
+            .unwrap()
+            .trim_end()
+            .trim_end_matches(')');
+        n.split_whitespace()
+            .next()
+            .unwrap()
+            .parse::<usize>()
+            .unwrap()
+    };
+    assert_eq!(threads(false, None), cpus);
+    assert_eq!(threads(true, None), 1);
+    assert_eq!(threads(true, Some("3")), 3);
+}
