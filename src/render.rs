@@ -102,9 +102,12 @@ pub fn render(
 /// rows from `y0` down, `pixels.len()` a whole number of rows.
 pub type BandDone<'a> = &'a (dyn Fn(u32, &[Vec3]) + Sync);
 
-/// [`render`], handing every row to `done` as soon as it is finished, a band of rows at a time:
-/// on the thread that finished them, in no set order, each row exactly once, all before this
-/// returns. A caller can write the frame out while the rest of it renders.
+/// [`render`]'s frame, every row handed to `done` as soon as it is finished, a band of rows at
+/// a time: on the thread that finished them, in no set order, each row exactly once, all before
+/// this returns, which gives the frame's stats. A caller can write the frame out while the rest
+/// of it renders. A frame of one sample is never held whole: each thread renders a band into
+/// rows of its own and reuses them for its next band (a 500×500 frame would otherwise be 3 MB
+/// of fresh memory for the kernel to zero, written out after it has left the caches).
 pub fn render_streamed(
     scene: &Scene,
     camera: &Camera,
@@ -113,7 +116,7 @@ pub fn render_streamed(
     width: u32,
     height: u32,
     done: BandDone,
-) -> Frame {
+) -> FrameStats {
     render_impl(
         scene,
         camera,
@@ -125,6 +128,7 @@ pub fn render_streamed(
         false,
         Some(done),
     )
+    .stats
 }
 
 /// Renders a frame, reusing `cache`'s primary hits when they are still valid (one sample per
@@ -226,7 +230,14 @@ fn render_impl(
     };
     let rays = camera.rays(width, height);
     let (w, h) = (width as usize, height as usize);
-    let mut image = Image::new(width, height);
+    // A streamed frame of one sample goes out band by band from each thread's own rows
+    // (`render_streamed`): it has no image, and its `Frame` (never returned) a 0×0 one.
+    let own_rows = done.is_some() && samples == 1;
+    let mut image = if own_rows {
+        Image::new(0, 0)
+    } else {
+        Image::new(width, height)
+    };
     // Path-traced frames split every sample for the denoiser (same colour, in any case).
     let split = tracer.splits();
     let draws = tracer.draws_random_numbers();
@@ -275,10 +286,15 @@ fn render_impl(
         // rays are traced together (`Scene::intersect_tile`), then shaded. Every thread takes
         // the next band until none is left, the calling thread too, from the top and the
         // others from the bottom (`on_every_thread`).
+        // The image's rows by band, or none (each thread's own rows instead).
+        let mut pixel_bands: Vec<Option<&mut [Vec3]>> = if own_rows {
+            (0..h.div_ceil(TILE)).map(|_| None).collect()
+        } else {
+            image.pixels.chunks_mut(TILE * w).map(Some).collect()
+        };
         let bands = Mutex::new(
-            image
-                .pixels
-                .chunks_mut(TILE * w)
+            pixel_bands
+                .iter_mut()
                 .zip(hit_bands.iter_mut())
                 .zip(guide_rows.chunks_mut(TILE))
                 .enumerate(),
@@ -291,12 +307,22 @@ fn render_impl(
             let mut tile_colours = [Vec3::ZERO; TILE_RAYS];
             let mut scratch = TileScratch::default();
             let mut tile_cache = TileCache::default();
+            let mut own = Vec::new();
             loop {
                 let next = next_band(&bands, from_back);
                 let Some((band, ((pixels, hits), guide_rows))) = next else {
                     return n;
                 };
                 let (y0, rows) = (band * TILE, guide_rows.len());
+                // Every pixel of a band is written below, so rows of this thread's own are
+                // reused as they are.
+                let pixels: &mut [Vec3] = match pixels {
+                    Some(p) => p,
+                    None => {
+                        own.resize(own.len().max(rows * w), Vec3::ZERO);
+                        &mut own[..rows * w]
+                    }
+                };
                 for x0 in (0..w).step_by(TILE) {
                     let cols = (w - x0).min(TILE);
                     // The tile's row `dy` (`cols` rays from `dy·cols`) in the band's rows.
@@ -391,7 +417,7 @@ fn render_impl(
                 }
             }
         });
-        drop(hit_bands);
+        drop((pixel_bands, hit_bands));
         if let Some(c) = cache {
             c.key = key;
         }

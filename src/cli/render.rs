@@ -136,26 +136,33 @@ pub(super) fn run_render(
         }
         _ => None,
     };
-    let frame = match &streamed {
-        _ if denoised => render_denoised(&scene, &camera, &lights, &settings, w, h),
-        Some(bands) => render_streamed(&scene, &camera, &lights, &settings, w, h, &|y0, rows| {
-            bands.write(y0, rows)
-        }),
-        None => render(&scene, &camera, &lights, &settings, w, h),
-    };
-    let written = match format {
-        Format::Png => frame.image.write_png(&mut out),
-        Format::Pfm => match streamed {
-            Some(bands) => bands.finish(),
-            None => frame.image.write_pfm(&mut out),
-        },
-        Format::Ansi | Format::Ansi256 | Format::Ascii => {
-            let mode = match format {
-                Format::Ansi => ColorMode::TrueColor,
-                Format::Ansi256 => ColorMode::Ansi256,
-                _ => ColorMode::Ascii,
+    let (stats, written) = match streamed {
+        // Written as it renders: the frame is never held whole.
+        Some(bands) => {
+            let stats = render_streamed(&scene, &camera, &lights, &settings, w, h, &|y0, rows| {
+                bands.write(y0, rows)
+            });
+            (stats, bands.finish())
+        }
+        _ => {
+            let frame = if denoised {
+                render_denoised(&scene, &camera, &lights, &settings, w, h)
+            } else {
+                render(&scene, &camera, &lights, &settings, w, h)
             };
-            out.write_all(&encode_text(&CellGrid::from_image(&frame.image, mode)))
+            let written = match format {
+                Format::Png => frame.image.write_png(&mut out),
+                Format::Pfm => frame.image.write_pfm(&mut out),
+                Format::Ansi | Format::Ansi256 | Format::Ascii => {
+                    let mode = match format {
+                        Format::Ansi => ColorMode::TrueColor,
+                        Format::Ansi256 => ColorMode::Ansi256,
+                        _ => ColorMode::Ascii,
+                    };
+                    out.write_all(&encode_text(&CellGrid::from_image(&frame.image, mode)))
+                }
+            };
+            (frame.stats, written)
         }
     };
     written
@@ -170,9 +177,9 @@ pub(super) fn run_render(
         .with_context(|| cannot_write(args))?;
     match args.stats {
         Some(StatsFormat::Text) => {
-            eprintln!("raytty: {w}x{h}, {}", frame.stats.summary(scene.isa()))
+            eprintln!("raytty: {w}x{h}, {}", stats.summary(scene.isa()))
         }
-        Some(StatsFormat::Json) => eprintln!("{}", frame.stats.to_json(scene.isa())),
+        Some(StatsFormat::Json) => eprintln!("{}", stats.to_json(scene.isa())),
         None => {}
     }
     Ok(())
