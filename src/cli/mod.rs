@@ -14,7 +14,6 @@ pub mod scene_arg;
 #[cfg(feature = "tui")]
 use std::io::IsTerminal;
 use std::io::{self, Write};
-use std::process::ExitCode;
 
 use clap::{CommandFactory, FromArgMatches};
 use raytty::{ColorMode, Stage};
@@ -23,8 +22,8 @@ use args::*;
 use bench::run_bench;
 use render::{RenderColor, run_render, text_format, without_os_error};
 
-/// Parses the command line, runs it, and maps the outcome to an exit code.
-pub fn main() -> ExitCode {
+/// Parses the command line, runs it, and maps the outcome to an exit status.
+pub fn main() -> u8 {
     #[allow(unused_mut)]
     let mut cmd = Cli::command();
     // The app's keys, under `--help` (and `help`): built only when asked for.
@@ -53,29 +52,29 @@ pub fn main() -> ExitCode {
                 own: args.color.map(resolve),
                 inherited: color_given.map(resolve),
             };
-            run_render(&args, cli.scene.as_deref(), no_color, colors).map(|()| ExitCode::SUCCESS)
+            run_render(&args, cli.scene.as_deref(), no_color, colors).map(|()| 0)
         }
         Some(Command::Scenes) => stdout_is_open("the list").and_then(|()| {
             io::stdout()
                 .write_all(crate::cli::scene_arg::list().as_bytes())
-                .map(|()| ExitCode::SUCCESS)
+                .map(|()| 0)
                 .map_err(Into::into)
         }),
         Some(Command::Bench(a)) => stdout_is_open("the table")
             .and_then(|()| run_bench(a, cli.scene.as_deref()))
-            .map(|()| ExitCode::SUCCESS),
+            .map(|()| 0),
         None => run_default(color, cli.scene.as_deref(), dumb),
     };
     match result {
         Ok(code) => code,
         Err(Failure::Usage(message)) => {
             eprintln!("raytty: {}", without_os_error(&message));
-            ExitCode::from(2)
+            2
         }
-        Err(Failure::Run(e)) if is_broken_pipe(&e) => ExitCode::SUCCESS,
+        Err(Failure::Run(e)) if is_broken_pipe(&e) => 0,
         Err(Failure::Run(e)) => {
             eprintln!("raytty: {}", without_os_error(&format!("{e:#}")));
-            ExitCode::from(1)
+            1
         }
     }
 }
@@ -90,12 +89,12 @@ pub fn signal_status(sig: i32) -> u8 {
 /// The exit status of the app: 0 on quit, [`signal_status`] of the signal, and for a dropped
 /// terminal that of SIGHUP (129), as if the hangup had been signalled.
 #[cfg(feature = "tui")]
-fn app_status(outcome: crate::tui::Outcome) -> ExitCode {
+fn app_status(outcome: crate::tui::Outcome) -> u8 {
     use crate::tui::Outcome;
     match outcome {
-        Outcome::Quit => ExitCode::SUCCESS,
-        Outcome::Signal(sig) => ExitCode::from(signal_status(sig)),
-        Outcome::Hangup => ExitCode::from(signal_status(libc::SIGHUP)),
+        Outcome::Quit => 0,
+        Outcome::Signal(sig) => signal_status(sig),
+        Outcome::Hangup => signal_status(libc::SIGHUP),
     }
 }
 
@@ -196,7 +195,7 @@ fn is_dumb(term: Option<&str>) -> bool {
 
 /// No command: the app on a terminal; otherwise (or on a dumb terminal) one frame to stdout,
 /// as `raytty render` with its defaults would print in `color`.
-fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<ExitCode> {
+fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<u8> {
     #[cfg(feature = "tui")]
     if io::stdout().is_terminal() {
         if !dumb {
@@ -238,7 +237,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<Exit
         false,
         RenderColor::default(),
     )?;
-    Ok(ExitCode::SUCCESS)
+    Ok(0)
 }
 
 #[cfg(test)]
