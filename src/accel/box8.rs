@@ -164,7 +164,7 @@ impl Box8 {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: checked available above.
-            Isa::Avx2 => unsafe { self.enter_avx2(origin, inv_dir, t_max) },
+            Isa::Avx2 | Isa::Avx512 => unsafe { self.enter_avx2(origin, inv_dir, t_max) },
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => self.enter_sse2(origin, inv_dir, t_max),
             _ => self.enter_portable(origin, inv_dir, t_max),

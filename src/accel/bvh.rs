@@ -156,7 +156,7 @@ impl Bvh {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller passes an available path.
-            Isa::Avx2 => unsafe { closest_avx2(self, ray, t_max) },
+            Isa::Avx2 | Isa::Avx512 => unsafe { closest_avx2(self, ray, t_max) },
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => self.closest::<Sse2>(ray, t_max),
             _ => self.closest::<Portable>(ray, t_max),
@@ -170,7 +170,7 @@ impl Bvh {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller passes an available path.
-            Isa::Avx2 => unsafe { occluded_avx2(self, ray, t_max) },
+            Isa::Avx2 | Isa::Avx512 => unsafe { occluded_avx2(self, ray, t_max) },
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => self.any::<Sse2>(ray, t_max),
             _ => self.any::<Portable>(ray, t_max),
@@ -192,7 +192,7 @@ impl Bvh {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller passes an available path.
-            Isa::Avx2 => unsafe { closest_each_avx2(self, tile, t_max, hits, found) },
+            Isa::Avx2 | Isa::Avx512 => unsafe { closest_each_avx2(self, tile, t_max, hits, found) },
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => self.closest_each::<Sse2>(tile, t_max, hits, found),
             _ => self.closest_each::<Portable>(tile, t_max, hits, found),
@@ -206,7 +206,7 @@ impl Bvh {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller passes an available path.
-            Isa::Avx2 => unsafe { any_each_avx2(self, rays, t_max, out) },
+            Isa::Avx2 | Isa::Avx512 => unsafe { any_each_avx2(self, rays, t_max, out) },
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => self.any_each::<Sse2>(rays, t_max, out),
             _ => self.any_each::<Portable>(rays, t_max, out),

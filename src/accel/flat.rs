@@ -94,7 +94,7 @@ impl Flat {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller passes an available path.
-            Isa::Avx2 => unsafe { closest_avx2(self, ray, t_max) },
+            Isa::Avx2 | Isa::Avx512 => unsafe { closest_avx2(self, ray, t_max) },
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => closest::<super::tri4::Sse2>(self, ray, t_max),
             _ => closest::<Portable>(self, ray, t_max),
@@ -118,6 +118,9 @@ impl Flat {
             // SAFETY: the caller passes an available path.
             Isa::Avx2 => unsafe { tile_avx2(self, tile, t_max, hits, cache) },
             #[cfg(target_arch = "x86_64")]
+            // SAFETY: the caller passes an available path.
+            Isa::Avx512 => unsafe { tile_avx512(self, tile, t_max, hits, cache) },
+            #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => {
                 tile::intersect_tile::<super::tri4::Sse2>(self, tile, t_max, hits, cache, |r| {
                     closest::<super::tri4::Sse2>(self, r, t_max)
@@ -130,18 +133,29 @@ impl Flat {
     }
 
     /// [`Flat::intersect_tile`] with AVX2 (which the CPU must have), the hits left as the
-    /// kernel makes them: ray `i` is lane `i % 8` of `best[i / 8]`.
+    /// kernel makes them: ray `i` is lane `i % 8` of `best[i / 8]`. AVX-512 (`isa`) traces
+    /// sixteen rays at a time, the same hits.
     #[cfg(target_arch = "x86_64")]
-    pub(crate) fn intersect_tile_best_avx2(
+    pub(crate) fn intersect_tile_best_wide(
         &self,
+        isa: Isa,
         tile: &RayTile,
         t_max: f32,
         best: &mut [Best8; TILE_RAYS / 8],
         cache: &mut TileCache,
     ) {
-        assert!(Isa::Avx2.available(), "AVX2 is not available");
+        assert!(
+            matches!(isa, Isa::Avx2 | Isa::Avx512) && isa.available(),
+            "{} is not available",
+            isa.name()
+        );
         // SAFETY: checked just above.
-        unsafe { tile_best_avx2(self, tile, t_max, best, cache) }
+        unsafe {
+            match isa {
+                Isa::Avx512 => tile_best_avx512(self, tile, t_max, best, cache),
+                _ => tile_best_avx2(self, tile, t_max, best, cache),
+            }
+        }
     }
 
     /// [`Flat::occluded`] for each of `rays`, into `out` (as many), on path `isa` (must be
@@ -151,7 +165,7 @@ impl Flat {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller passes an available path.
-            Isa::Avx2 => unsafe { occluded_each_avx2(self, rays, t_max, out) },
+            Isa::Avx2 | Isa::Avx512 => unsafe { occluded_each_avx2(self, rays, t_max, out) },
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => occluded_all::<super::tri4::Sse2>(self, rays, t_max, out),
             _ => occluded_all::<Portable>(self, rays, t_max, out),
@@ -164,7 +178,7 @@ impl Flat {
         match isa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller passes an available path.
-            Isa::Avx2 => unsafe { occluded_avx2(self, ray, t_max) },
+            Isa::Avx2 | Isa::Avx512 => unsafe { occluded_avx2(self, ray, t_max) },
             #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => occluded::<super::tri4::Sse2>(self, ray, t_max),
             _ => occluded::<Portable>(self, ray, t_max),
@@ -225,6 +239,34 @@ unsafe fn tile_best_avx2(
 ) {
     tile::intersect_tile_best::<super::tri4::Avx2>(f, tile, t_max, best, cache, |r| {
         closest::<super::tri4::Avx2>(f, r, t_max)
+    });
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+unsafe fn tile_avx512(
+    f: &Flat,
+    tile: &RayTile,
+    t_max: f32,
+    hits: &mut [Option<Hit>],
+    cache: &mut TileCache,
+) {
+    tile::intersect_tile::<super::tri4::Avx512>(f, tile, t_max, hits, cache, |r| {
+        closest::<super::tri4::Avx512>(f, r, t_max)
+    });
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+unsafe fn tile_best_avx512(
+    f: &Flat,
+    tile: &RayTile,
+    t_max: f32,
+    best: &mut [Best8; TILE_RAYS / 8],
+    cache: &mut TileCache,
+) {
+    tile::intersect_tile_best::<super::tri4::Avx512>(f, tile, t_max, best, cache, |r| {
+        closest::<super::tri4::Avx512>(f, r, t_max)
     });
 }
 

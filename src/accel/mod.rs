@@ -204,7 +204,7 @@ impl Accel {
 
     /// [`Accel::intersect_tile`], the hits as lanes: ray `i`'s is lane `i % 8` of
     /// `best[i / 8]` (lanes past the tile's rays are not to be read). The flat list on AVX2
-    /// leaves them there as its kernel makes them; other structures and paths are asked for
+    /// and AVX-512 leaves them there as its kernel makes them; other structures and paths are asked for
     /// [`Hit`]s, which are then put in lanes. The same hits either way.
     pub fn intersect_tile_best(
         &self,
@@ -214,8 +214,8 @@ impl Accel {
         cache: &mut TileCache,
     ) {
         #[cfg(target_arch = "x86_64")]
-        if let (Structure::Flat(flat), Isa::Avx2) = (&self.structure, self.isa) {
-            flat.intersect_tile_best_avx2(tile, t_max, best, cache);
+        if let (Structure::Flat(flat), Isa::Avx2 | Isa::Avx512) = (&self.structure, self.isa) {
+            flat.intersect_tile_best_wide(self.isa, tile, t_max, best, cache);
             return;
         }
         let mut hits = [None; TILE_RAYS];

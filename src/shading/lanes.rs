@@ -82,7 +82,8 @@ impl Tracer<'_> {
     /// Whether [`Tracer::shade_tile_lanes`] shades this frame's tiles: AVX2 queries and a scene
     /// small enough for the shadow cull.
     pub(super) fn shades_in_lanes(&self) -> bool {
-        self.scene.isa() == Isa::Avx2 && self.scene.triangles().len() <= SHADOW_TILE_TRIANGLES
+        matches!(self.scene.isa(), Isa::Avx2 | Isa::Avx512)
+            && self.scene.triangles().len() <= SHADOW_TILE_TRIANGLES
     }
 
     /// [`Tracer::shade_tile`] in lanes (see the module's doc). Only when

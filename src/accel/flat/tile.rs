@@ -275,6 +275,16 @@ impl Cull for crate::accel::tri4::Avx2 {
     }
 }
 
+#[cfg(target_arch = "x86_64")]
+impl Cull for crate::accel::tri4::Avx512 {
+    #[inline(always)]
+    fn kept(cache: &TileCache, sx: (f64, f64), sy: (f64, f64)) -> u64 {
+        // SAFETY: `Avx512` is only instantiated behind a check that the CPU has AVX-512, which
+        // includes AVX2.
+        unsafe { cache.kept_avx2(sx, sy) }
+    }
+}
+
 /// Fills `t`'s edge coefficients and margins for shears up to (`smx`, `smy`) in magnitude.
 fn edges(rel: &[[f32; 3]; 3], smx: f64, smy: f64, t: &mut TileTri) {
     let (g2, g5) = (gamma(2) as f64, gamma(5) as f64);

@@ -454,6 +454,49 @@ impl Kernel for Avx2 {
     }
 }
 
+/// The AVX-512 path: AVX2's kernels but for a tile's rays, sixteen lanes at a time. Only used
+/// inside functions compiled with AVX-512 enabled, which are only called once [`Isa::Avx512`]
+/// is known to be available.
+#[cfg(target_arch = "x86_64")]
+pub(crate) struct Avx512;
+
+#[cfg(target_arch = "x86_64")]
+impl Kernel for Avx512 {
+    const AVX2: bool = true;
+    #[inline(always)]
+    fn one(block: &Tri4, ray: &Ray, r: &RayLanes, t_max: f32, out: &mut LaneHits) -> (u32, u32) {
+        Avx2::one(block, ray, r, t_max, out)
+    }
+    #[inline(always)]
+    fn two(
+        a: &Tri4,
+        b: &Tri4,
+        ray: &Ray,
+        r: &RayLanes,
+        t_max: f32,
+        out: &mut LaneHits,
+    ) -> (u32, u32) {
+        Avx2::two(a, b, ray, r, t_max, out)
+    }
+    #[inline(always)]
+    fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
+        Avx2::boxes(b, origin, inv_dir, t_max)
+    }
+    #[inline(always)]
+    fn rays(
+        _: &[Vec3; 3],
+        rel: &[[f32; 3]; 3],
+        tile: &RayTile,
+        t_max: f32,
+        id: u32,
+        sure: bool,
+        best: &mut [Best8],
+    ) -> u64 {
+        // SAFETY: `Avx512` is only instantiated behind a check that the CPU has AVX-512.
+        unsafe { x86::rays_avx512(rel, tile, t_max, id, sure, best) }
+    }
+}
+
 /// The hits of `ray` in one block on path `isa` (for tests and tools; traversals call the
 /// kernels directly). `isa` must be available.
 pub fn hits(isa: Isa, block: &Tri4, ray: &Ray, t_max: f32) -> Hits {
@@ -470,7 +513,7 @@ pub fn hits(isa: Isa, block: &Tri4, ray: &Ray, t_max: f32) -> Hits {
         Isa::Sse2 => Sse2::one(block, ray, &r, t_max, &mut out),
         #[cfg(target_arch = "x86_64")]
         // SAFETY: checked available above.
-        Isa::Avx2 => unsafe { x86::hits_avx2_call(block, &r, t_max, &mut out) },
+        Isa::Avx2 | Isa::Avx512 => unsafe { x86::hits_avx2_call(block, &r, t_max, &mut out) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => unreachable!(),
     };
@@ -492,7 +535,7 @@ pub fn hits2(isa: Isa, a: &Tri4, b: &Tri4, ray: &Ray, t_max: f32) -> Hits {
         Isa::Sse2 => Sse2::two(a, b, ray, &r, t_max, &mut out),
         #[cfg(target_arch = "x86_64")]
         // SAFETY: checked available above.
-        Isa::Avx2 => unsafe { x86::hits2_avx2_call(a, b, &r, t_max, &mut out) },
+        Isa::Avx2 | Isa::Avx512 => unsafe { x86::hits2_avx2_call(a, b, &r, t_max, &mut out) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => unreachable!(),
     };

@@ -95,7 +95,7 @@ macro_rules! watertight_lanes {
         let redo = mask(any_zero);
         let pass = !mask(reject) & !redo & FULL;
         if pass == 0 {
-            (0, redo, zero, zero, zero, zero, zero)
+            (0, redo, zero, zero, zero, zero, no_lanes())
         } else {
             let one = splat(1.0);
             let inv_det = div(one, det);
@@ -257,6 +257,11 @@ mod sse {
     pub fn mask(a: V) -> u32 {
         unsafe { _mm_movemask_ps(a) as u32 }
     }
+    /// The mask of no lane.
+    #[inline(always)]
+    pub fn no_lanes() -> V {
+        unsafe { _mm_setzero_ps() }
+    }
 }
 
 /// Eight lanes of AVX, under the names [`watertight_lanes`] uses. Compiled for AVX2 (the path's
@@ -359,6 +364,136 @@ pub(super) mod avx {
     #[inline]
     pub fn mask(a: V) -> u32 {
         _mm256_movemask_ps(a) as u32
+    }
+    /// The mask of no lane.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn no_lanes() -> V {
+        _mm256_setzero_ps()
+    }
+}
+
+/// Sixteen lanes of AVX-512, under the names [`watertight_lanes`] uses: the same IEEE
+/// operations on wider registers, so each lane's result is AVX2's bits. Comparisons give masks
+/// (`M`, a bit per lane) rather than vectors; `and`, `or`, `andnot` and `select` take those.
+/// Compiled for the path's features, so they inline into its kernels.
+pub(super) mod avx512 {
+    use std::arch::x86_64::*;
+
+    pub type V = __m512;
+    pub type M = __mmask16;
+    pub const FULL: u32 = 0xffff;
+
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn splat(x: f32) -> V {
+        _mm512_set1_ps(x)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn add(a: V, b: V) -> V {
+        _mm512_add_ps(a, b)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn sub(a: V, b: V) -> V {
+        _mm512_sub_ps(a, b)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn mul(a: V, b: V) -> V {
+        _mm512_mul_ps(a, b)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn div(a: V, b: V) -> V {
+        _mm512_div_ps(a, b)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn abs(a: V) -> V {
+        _mm512_andnot_ps(_mm512_set1_ps(-0.0), a)
+    }
+    /// `f32::max` where neither is NaN.
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn max(a: V, b: V) -> V {
+        _mm512_max_ps(a, b)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn and(a: M, b: M) -> M {
+        a & b
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn or(a: M, b: M) -> M {
+        a | b
+    }
+    /// `b` where `a` is clear.
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn andnot(a: M, b: M) -> M {
+        !a & b
+    }
+    /// `b` where `m` is set, else `a`.
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn select(m: M, a: V, b: V) -> V {
+        _mm512_mask_blend_ps(m, a, b)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn eq(a: V, b: V) -> M {
+        _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn lt(a: V, b: V) -> M {
+        _mm512_cmp_ps_mask::<_CMP_LT_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn le(a: V, b: V) -> M {
+        _mm512_cmp_ps_mask::<_CMP_LE_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn gt(a: V, b: V) -> M {
+        _mm512_cmp_ps_mask::<_CMP_GT_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn ge(a: V, b: V) -> M {
+        _mm512_cmp_ps_mask::<_CMP_GE_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn unord(a: V, b: V) -> M {
+        _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(a, b)
+    }
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn mask(a: M) -> u32 {
+        a as u32
+    }
+    /// The mask of no lane.
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn no_lanes() -> M {
+        0
+    }
+    /// Eight lanes of `lo` and eight of `hi`, as one vector.
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn join(lo: __m256, hi: __m256) -> V {
+        _mm512_insertf32x8::<1>(_mm512_castps256_ps512(lo), hi)
+    }
+    /// The two halves of `v`.
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    #[inline]
+    pub fn halves(v: V) -> (__m256, __m256) {
+        (_mm512_castps512_ps256(v), _mm512_extractf32x8_ps::<1>(v))
     }
 }
 
@@ -487,6 +622,25 @@ pub unsafe fn rays_avx2(
     sure: bool,
     best: &mut [Best8],
 ) -> u64 {
+    // SAFETY: this function's contract.
+    unsafe { rays_avx2_from(rel, tile, t_max, id, sure, best, 0) }
+}
+
+/// [`rays_avx2`] for the packets of `best`, which are the tile's from packet `first` on.
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn rays_avx2_from(
+    rel: &[[f32; 3]; 3],
+    tile: &RayTile,
+    t_max: f32,
+    id: u32,
+    sure: bool,
+    best: &mut [Best8],
+    first: usize,
+) -> u64 {
     use avx::*;
     let [[a0, b0, z0], [a1, b1, z1], [a2, b2, z2]] = rel;
     let (a0, b0, z0) = (splat(*a0), splat(*b0), splat(*z0));
@@ -496,7 +650,7 @@ pub unsafe fn rays_avx2(
     let id = _mm256_castsi256_ps(_mm256_set1_epi32(id as i32));
     let mut redo_all = 0;
     for (p, best) in best.iter_mut().enumerate() {
-        let at = 8 * p;
+        let at = 8 * (first + p);
         // SAFETY: every load and store reads or writes eight `f32`s, 32-byte aligned (the
         // tile's lanes are aligned and `at` is a multiple of 8 below `TILE_RAYS`).
         let load = |p: &[f32]| unsafe { _mm256_load_ps(p[..8].as_ptr()) };
@@ -523,6 +677,92 @@ pub unsafe fn rays_avx2(
                 _mm256_store_si256(best.id.as_mut_ptr().cast(), ids);
             }
         }
+    }
+    redo_all
+}
+
+/// [`rays_avx2`] with AVX-512, sixteen lanes (two packets) at a time; an odd last packet
+/// with AVX2. The same operations lane by lane, so the same `best` and redo bits.
+///
+/// # Safety
+/// The CPU must have AVX-512 F, DQ, VL and BW ([`super::Isa::Avx512`] available).
+#[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+#[inline]
+pub unsafe fn rays_avx512(
+    rel: &[[f32; 3]; 3],
+    tile: &RayTile,
+    t_max: f32,
+    id: u32,
+    sure: bool,
+    best: &mut [Best8],
+) -> u64 {
+    use avx512::*;
+    let [[a0, b0, z0], [a1, b1, z1], [a2, b2, z2]] = rel;
+    let (a0, b0, z0) = (splat(*a0), splat(*b0), splat(*z0));
+    let (a1, b1, z1) = (splat(*a1), splat(*b1), splat(*z1));
+    let (a2, b2, z2) = (splat(*a2), splat(*b2), splat(*z2));
+    let t_max_v = splat(t_max);
+    let id_v = _mm512_castsi512_ps(_mm512_set1_epi32(id as i32));
+    let mut redo_all = 0;
+    let pairs = best.len() / 2;
+    for (q, pair) in best.chunks_exact_mut(2).enumerate() {
+        let at = 16 * q;
+        // SAFETY: each load reads sixteen `f32`s of a tile row of `TILE_RAYS` (`at + 16` is at
+        // most `TILE_RAYS`: `best` holds at most `TILE_RAYS / 8` packets).
+        let load = |p: &[f32]| unsafe { _mm512_loadu_ps(p[..16].as_ptr()) };
+        let s = &tile.shear;
+        let (mask, redo, t, w0, w1, w2, accepted) = watertight_lanes!(
+            avx512,
+            [a0, b0, z0, a1, b1, z1, a2, b2, z2],
+            [load(&s[0][at..]), load(&s[1][at..]), load(&s[2][at..])],
+            t_max_v,
+            sure
+        );
+        redo_all |= (redo as u64) << at;
+        if mask != 0 {
+            let (lo, hi) = pair.split_at_mut(1);
+            let (lo, hi) = (&mut lo[0], &mut hi[0]);
+            // SAFETY: every load and store reads or writes a whole 32-byte-aligned `[f32; 8]`
+            // or `[u32; 8]` of the two packets; the ids are moved as bits.
+            unsafe {
+                let ld = |a: &[f32; 8], b: &[f32; 8]| {
+                    join(_mm256_load_ps(a.as_ptr()), _mm256_load_ps(b.as_ptr()))
+                };
+                let st = |a: &mut [f32; 8], b: &mut [f32; 8], v| {
+                    let (l, h) = halves(v);
+                    _mm256_store_ps(a.as_mut_ptr(), l);
+                    _mm256_store_ps(b.as_mut_ptr(), h);
+                };
+                let best_t = ld(&lo.t, &hi.t);
+                let take = and(accepted, lt(t, best_t));
+                st(&mut lo.t, &mut hi.t, select(take, best_t, t));
+                for (k, w) in [w0, w1, w2].into_iter().enumerate() {
+                    let old = ld(&lo.b[k], &hi.b[k]);
+                    st(&mut lo.b[k], &mut hi.b[k], select(take, old, w));
+                }
+                let ids = join(
+                    _mm256_castsi256_ps(_mm256_load_si256(lo.id.as_ptr().cast())),
+                    _mm256_castsi256_ps(_mm256_load_si256(hi.id.as_ptr().cast())),
+                );
+                let (l, h) = halves(select(take, ids, id_v));
+                _mm256_store_si256(lo.id.as_mut_ptr().cast(), _mm256_castps_si256(l));
+                _mm256_store_si256(hi.id.as_mut_ptr().cast(), _mm256_castps_si256(h));
+            }
+        }
+    }
+    if best.len() % 2 == 1 {
+        // SAFETY: the CPU has AVX2 (this function's contract).
+        redo_all |= unsafe {
+            rays_avx2_from(
+                rel,
+                tile,
+                t_max,
+                id,
+                sure,
+                &mut best[2 * pairs..],
+                2 * pairs,
+            )
+        };
     }
     redo_all
 }
