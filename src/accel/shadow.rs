@@ -53,6 +53,8 @@ use glam::Vec3;
 use crate::geometry::{Triangle, gamma};
 
 #[cfg(target_arch = "x86_64")]
+use super::tri4::shadow::any_hit8_in;
+#[cfg(target_arch = "x86_64")]
 pub use super::tri4::shadow::{ShadowRays8, any_hit8_avx2};
 
 /// Scenes of at most this many triangles trace a tile's shadow rays together (the cull looks
@@ -178,6 +180,17 @@ impl ShadowCull {
         self.kept_with_margin(lo, hi, 1.0)
     }
 
+    /// [`ShadowCull::kept`] as a copy of its own for each `COPY` (see
+    /// [`ShadowCull::occluded8_in`]).
+    #[inline]
+    pub(crate) fn kept_in<const COPY: u8>(&self, lo: Vec3, hi: Vec3) -> u64 {
+        #[cfg(target_arch = "x86_64")]
+        let avx = std::is_x86_feature_detected!("avx");
+        #[cfg(not(target_arch = "x86_64"))]
+        let avx = false;
+        self.kept_on::<COPY>(lo, hi, 1.0, avx)
+    }
+
     /// [`ShadowCull::kept`] with the margin scaled by `scale` (1 in use; the tests show that
     /// 0 drops triangles the scalar test hits).
     pub(crate) fn kept_with_margin(&self, lo: Vec3, hi: Vec3, scale: f64) -> u64 {
@@ -185,12 +198,12 @@ impl ShadowCull {
         let avx = std::is_x86_feature_detected!("avx");
         #[cfg(not(target_arch = "x86_64"))]
         let avx = false;
-        self.kept_on(lo, hi, scale, avx)
+        self.kept_on::<0>(lo, hi, scale, avx)
     }
 
     /// [`ShadowCull::kept_with_margin`], the plane tests with AVX (which the CPU must have) or
     /// portably: the same answer.
-    fn kept_on(&self, lo: Vec3, hi: Vec3, scale: f64, avx: bool) -> u64 {
+    fn kept_on<const COPY: u8>(&self, lo: Vec3, hi: Vec3, scale: f64, avx: bool) -> u64 {
         let l = self.light.map(f32::from_bits).map(f64::from);
         let (lo, hi) = (lo.to_array().map(f64::from), hi.to_array().map(f64::from));
         // `L − o` over the box: centre and half extent (widened for their rounding), and
@@ -222,7 +235,7 @@ impl ShadowCull {
         #[cfg(target_arch = "x86_64")]
         if avx {
             // SAFETY: the caller passes `avx` only where the CPU has it.
-            unsafe { planes_avx(&self.groups, &cu, &ru, m, &mut neg, &mut pos) };
+            unsafe { planes_avx::<COPY>(&self.groups, &cu, &ru, m, &mut neg, &mut pos) };
         }
         for (gi, g) in self.groups.iter().enumerate() {
             if avx {
@@ -301,7 +314,7 @@ unsafe fn planes4_avx(g: &Planes4, cu: &[f64; 3], ru: &[f64; 3], m: f64) -> ([u3
 /// The CPU must have AVX.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
-unsafe fn planes_avx(
+unsafe fn planes_avx<const COPY: u8>(
     groups: &[Planes4],
     cu: &[f64; 3],
     ru: &[f64; 3],
@@ -337,6 +350,26 @@ impl ShadowCull {
         t_max: f32,
         ray: impl Fn(usize) -> crate::geometry::Ray,
     ) -> u32 {
+        // SAFETY: this function's contract.
+        unsafe { self.occluded8_in::<0>(kept, rays, lanes, oz, t_max, ray) }
+    }
+
+    /// [`ShadowCull::occluded8_avx2`] as a copy of its own for each `COPY`: the shading kernel
+    /// is compiled twice (AVX2, AVX-512), and a copy per compilation is inlined into it.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    pub(crate) unsafe fn occluded8_in<const COPY: u8>(
+        &self,
+        kept: u64,
+        rays: &ShadowRays8,
+        lanes: u32,
+        oz: (f32, f32),
+        t_max: f32,
+        ray: impl Fn(usize) -> crate::geometry::Ray,
+    ) -> u32 {
         let [kx, _, kz] = rays.axes;
         // `d_kz < 0` exactly when the axes are swapped.
         let forward = kx == (kz + 1) % 3;
@@ -351,7 +384,7 @@ impl ShadowCull {
                 continue;
             }
             // SAFETY: the CPU has AVX2 (this function's contract).
-            let (hit, redo) = unsafe { any_hit8_avx2(&t.lanes, rays, t_max) };
+            let (hit, redo) = unsafe { any_hit8_in::<COPY>(&t.lanes, rays, t_max) };
             blocked |= hit & lanes;
             let mut redo = redo & lanes & !blocked;
             while redo != 0 {
@@ -472,8 +505,8 @@ mod tests {
             #[cfg(target_arch = "x86_64")]
             if std::is_x86_feature_detected!("avx") {
                 assert_eq!(
-                    cull.kept_on(lo, hi, 1.0, true),
-                    cull.kept_on(lo, hi, 1.0, false)
+                    cull.kept_on::<0>(lo, hi, 1.0, true),
+                    cull.kept_on::<0>(lo, hi, 1.0, false)
                 );
             }
             for (i, t) in tris.iter().enumerate() {

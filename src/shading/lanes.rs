@@ -5,7 +5,9 @@
 //! the lights and the colours are computed in lanes, with the scalar code's `f32` operations in
 //! its order (no fused multiply-add; glam's `min`/`max` pick the operands SSE's do); the shadow
 //! rays stay lanes too ([`ShadowCull::occluded8_avx2`]), grouped by axes, after the tile's cull.
-//! So every colour and every ray count is the scalar path's, bit for bit.
+//! So every colour and every ray count is the scalar path's, bit for bit. On AVX-512 CPUs the
+//! same kernel runs compiled for AVX-512 (eight lanes still, but 32 registers and mask
+//! registers): one body, two copies, each with its own inlined helpers.
 
 use std::arch::x86_64::*;
 
@@ -21,6 +23,11 @@ use crate::scene::{Indirect, PointLight};
 
 /// Most pixels in a tile.
 const N: usize = TILE_RAYS;
+
+/// The kernel's copy compiled for AVX2 ([`Tracer::shade_tile_lanes_in`]'s `COPY`).
+const ON_AVX2: u8 = 0;
+/// The kernel's copy compiled for AVX-512.
+const ON_AVX512: u8 = 1;
 
 /// One `f32` per pixel of a tile, per axis.
 type Lanes = [[f32; N]; 3];
@@ -114,13 +121,50 @@ impl Tracer<'_> {
         s: &mut LaneScratch,
     ) {
         assert!(self.shades_in_lanes() && rays.len() <= N && out.len() == rays.len());
-        // SAFETY: the scene's queries take the AVX2 path, which is only set where the CPU has it.
-        unsafe { self.shade_tile_avx2(rays, best, out, n, s) }
+        // SAFETY: the scene's queries take the AVX2 or the AVX-512 path, which is only set
+        // where the CPU has it.
+        unsafe {
+            if self.scene.isa() == Isa::Avx512 {
+                self.shade_tile_avx512(rays, best, out, n, s)
+            } else {
+                self.shade_tile_avx2(rays, best, out, n, s)
+            }
+        }
     }
 
+    /// [`Tracer::shade_tile_lanes_in`] compiled for AVX2.
+    #[target_feature(enable = "avx2")]
+    unsafe fn shade_tile_avx2(
+        &self,
+        rays: &RayTile,
+        best: &[Best8; N / 8],
+        out: &mut [Vec3],
+        n: &mut RayCounts,
+        s: &mut LaneScratch,
+    ) {
+        self.shade_tile_lanes_in::<ON_AVX2>(rays, best, out, n, s)
+    }
+
+    /// [`Tracer::shade_tile_lanes_in`] compiled for AVX-512: the same operations (eight
+    /// lanes), with 32 registers instead of 16 and comparisons into mask registers.
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    unsafe fn shade_tile_avx512(
+        &self,
+        rays: &RayTile,
+        best: &[Best8; N / 8],
+        out: &mut [Vec3],
+        n: &mut RayCounts,
+        s: &mut LaneScratch,
+    ) {
+        self.shade_tile_lanes_in::<ON_AVX512>(rays, best, out, n, s)
+    }
+
+    /// The kernel of [`Tracer::shade_tile_best_lanes`]. `COPY` ([`ON_AVX2`] or [`ON_AVX512`])
+    /// names the compilation it belongs to: each helper below is generic over it too, so that
+    /// every copy has a single caller, is inlined into it and compiled with its features.
     #[target_feature(enable = "avx2")]
     #[allow(clippy::needless_range_loop)] // lanes and axes, in step across several arrays
-    unsafe fn shade_tile_avx2(
+    fn shade_tile_lanes_in<const COPY: u8>(
         &self,
         rays: &RayTile,
         best: &[Best8; N / 8],
@@ -202,7 +246,7 @@ impl Tracer<'_> {
         let valid = |c: usize| (1u32 << (m - 8 * c).min(8)) - 1;
         let t_max = 1.0 - SHADOW_EPSILON;
         for c in 0..chunks {
-            hit_points8(tables, s, rays.dir_lanes(), 8 * c, (m - 8 * c).min(8));
+            hit_points8::<COPY>(tables, s, rays.dir_lanes(), 8 * c, (m - 8 * c).min(8));
         }
         s.sum = ZERO;
         for (li, light) in self.lights.iter().enumerate() {
@@ -213,7 +257,7 @@ impl Tracer<'_> {
             let mut lit = [0u32; N / 8];
             let mut traced = [0u32; N / 8];
             for c in 0..chunks {
-                let (l, t) = self.light_terms8(light, s, 8 * c);
+                let (l, t) = self.light_terms8::<COPY>(light, s, 8 * c);
                 lit[c] = l & valid(c);
                 traced[c] = t & lit[c];
             }
@@ -223,17 +267,17 @@ impl Tracer<'_> {
                 n.shadow += count as u64;
                 if count > 0 {
                     let cull = &tables.culls[li];
-                    let (lo, hi) = origin_box(s, &traced[..chunks]);
-                    let kept = cull.kept(lo, hi);
+                    let (lo, hi) = origin_box::<COPY>(s, &traced[..chunks]);
+                    let kept = cull.kept_in::<COPY>(lo, hi);
                     for c in 0..chunks {
                         if traced[c] != 0 {
-                            blocked[c] = shadows8(s, cull, kept, 8 * c, traced[c], t_max);
+                            blocked[c] = shadows8::<COPY>(s, cull, kept, 8 * c, traced[c], t_max);
                         }
                     }
                 }
             }
             for c in 0..chunks {
-                add_terms8(s, 8 * c, lit[c] & !blocked[c]);
+                add_terms8::<COPY>(s, 8 * c, lit[c] & !blocked[c]);
             }
         }
         let indirect = match self.settings.effects.indirect {
@@ -316,7 +360,12 @@ impl Tracer<'_> {
     /// `light_term` for the eight pixels from `o`: the term, origin and direction into `s`,
     /// and the lanes lit and the lanes with a shadow ray (bit per lane).
     #[target_feature(enable = "avx2")]
-    fn light_terms8(&self, light: &PointLight, s: &mut LaneScratch, o: usize) -> (u32, u32) {
+    fn light_terms8<const COPY: u8>(
+        &self,
+        light: &PointLight,
+        s: &mut LaneScratch,
+        o: usize,
+    ) -> (u32, u32) {
         let ld = |a: &[f32; N]| unsafe { _mm256_loadu_ps(a[o..].as_ptr()) };
         let st = |a: &mut [f32; N], v: __m256| unsafe { _mm256_storeu_ps(a[o..].as_mut_ptr(), v) };
         let lanes = light_lanes_avx2(
@@ -345,7 +394,13 @@ fn gather(table: &[f32; SHADOW_TILE_TRIANGLES], ids: __m256i) -> __m256 {
 /// `hit_point` and the normal facing the ray for the `count` (1 to 8) pixels from `o`
 /// (`dirs`: the tile's ray directions).
 #[target_feature(enable = "avx2")]
-fn hit_points8(t: &Tables, s: &mut LaneScratch, dirs: &Lanes, o: usize, count: usize) {
+fn hit_points8<const COPY: u8>(
+    t: &Tables,
+    s: &mut LaneScratch,
+    dirs: &Lanes,
+    o: usize,
+    count: usize,
+) {
     let ld = |a: &[f32; N]| unsafe { _mm256_loadu_ps(a[o..].as_ptr()) };
     let st = |a: &mut [f32; N], v: __m256| unsafe { _mm256_storeu_ps(a[o..].as_mut_ptr(), v) };
     // SAFETY: reads eight `i32`s.
@@ -438,7 +493,7 @@ fn min_max8(v: __m256, on: __m256) -> (f32, f32) {
 
 /// The box of the origins of the `traced` lanes (bit per lane, a word per chunk of eight).
 #[target_feature(enable = "avx2")]
-fn origin_box(s: &LaneScratch, traced: &[u32]) -> (Vec3, Vec3) {
+fn origin_box<const COPY: u8>(s: &LaneScratch, traced: &[u32]) -> (Vec3, Vec3) {
     let mut lo = [_mm256_set1_ps(f32::INFINITY); 3];
     let mut hi = [_mm256_set1_ps(f32::NEG_INFINITY); 3];
     for (c, &t) in traced.iter().enumerate() {
@@ -471,7 +526,7 @@ fn origin_box(s: &LaneScratch, traced: &[u32]) -> (Vec3, Vec3) {
 /// The shadow rays of the `traced` lanes of the eight pixels from `o` against the `kept`
 /// triangles of light `li`'s cull, in packets of one axis order: the lanes blocked.
 #[target_feature(enable = "avx2")]
-fn shadows8(
+fn shadows8<const COPY: u8>(
     s: &LaneScratch,
     cull: &ShadowCull,
     kept: u64,
@@ -540,14 +595,14 @@ fn shadows8(
             Ray::new(v(&s.origin), v(&s.dir))
         };
         // SAFETY: this function runs with AVX2.
-        blocked |= unsafe { cull.occluded8_avx2(kept, &rays, lanes, oz, t_max, ray) };
+        blocked |= unsafe { cull.occluded8_in::<COPY>(kept, &rays, lanes, oz, t_max, ray) };
     }
     blocked
 }
 
 /// `sum += term` in the `lanes` (bit per lane) of the eight pixels from `o`.
 #[target_feature(enable = "avx2")]
-fn add_terms8(s: &mut LaneScratch, o: usize, lanes: u32) {
+fn add_terms8<const COPY: u8>(s: &mut LaneScratch, o: usize, lanes: u32) {
     if lanes == 0 {
         return;
     }

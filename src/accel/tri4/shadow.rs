@@ -31,6 +31,22 @@ pub struct ShadowRays8 {
 #[target_feature(enable = "avx2")]
 #[inline]
 pub unsafe fn any_hit8_avx2(v: &[[f32; 4]; 3], rays: &ShadowRays8, t_max: f32) -> (u32, u32) {
+    // SAFETY: this function's contract.
+    unsafe { any_hit8_in::<0>(v, rays, t_max) }
+}
+
+/// [`any_hit8_avx2`] as a copy of its own for each `COPY` (one per compilation of the shading
+/// kernel that inlines it).
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(crate) unsafe fn any_hit8_in<const COPY: u8>(
+    v: &[[f32; 4]; 3],
+    rays: &ShadowRays8,
+    t_max: f32,
+) -> (u32, u32) {
     use avx::*;
     use std::arch::x86_64::*;
     // SAFETY: every load reads a whole 32-byte-aligned `[f32; 8]`.
