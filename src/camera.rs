@@ -107,10 +107,42 @@ impl RayGen {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2 (checked above).
-            unsafe { self.tile_avx2(x0, y0, cols, rows, out) };
+            unsafe { self.tile_avx2(x0, y0, cols, rows, None, out) };
             return;
         }
         self.tile_scalar(x0, y0, cols, rows, out);
+    }
+
+    /// Makes `out` the tile of `cols`×`rows` rays (`cols`, `rows` ≤ 8) through image positions
+    /// `(px[i], py[i])` in pixels, ray `r·cols + c` being `i = r·cols + c`: each is
+    /// `self.ray(px[i], py[i])` bit for bit (an anti-aliased frame's jittered rays), made eight
+    /// at a time with AVX2 where the CPU has it. Entries from `rows·cols` on are ignored.
+    pub fn tile_at(
+        &self,
+        cols: usize,
+        rows: usize,
+        px: &[f32; TILE_RAYS],
+        py: &[f32; TILE_RAYS],
+        out: &mut RayTile,
+    ) {
+        assert!(
+            (1..=8).contains(&cols) && (1..=8).contains(&rows),
+            "a tile is 1 to 8 pixels on a side"
+        );
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // The lanes past the last ray repeat it, so that every lane is a ray of the tile.
+            let n = rows * cols;
+            let (mut px, mut py) = (*px, *py);
+            let (last_x, last_y) = (px[n - 1], py[n - 1]);
+            px[n..].fill(last_x);
+            py[n..].fill(last_y);
+            // SAFETY: the CPU has AVX2 (checked above).
+            unsafe { self.tile_avx2(0, 0, cols, rows, Some((&px, &py)), out) };
+            return;
+        }
+        let rays: Vec<Ray> = (0..rows * cols).map(|i| self.ray(px[i], py[i])).collect();
+        *out = RayTile::from_rays(&rays);
     }
 
     /// [`RayGen::tile`] one ray at a time.
@@ -122,19 +154,29 @@ impl RayGen {
         *out = RayTile::from_rays(&rays);
     }
 
-    /// [`RayGen::tile`] a row of eight rays at a time.
+    /// [`RayGen::tile`] a row of eight rays at a time, through the pixel centres or, given
+    /// `positions` (then `x0`, `y0` unused), through those ([`RayGen::tile_at`], whose
+    /// padding every lane's eight reads rely on).
     ///
     /// # Safety
     /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn tile_avx2(&self, x0: usize, y0: usize, cols: usize, rows: usize, out: &mut RayTile) {
+    unsafe fn tile_avx2(
+        &self,
+        x0: usize,
+        y0: usize,
+        cols: usize,
+        rows: usize,
+        positions: Option<(&[f32; TILE_RAYS], &[f32; TILE_RAYS])>,
+        out: &mut RayTile,
+    ) {
         use std::arch::x86_64::*;
         let splat = |v: f32| _mm256_set1_ps(v);
         // Columns past the tile's repeat its last one: every lane is a ray of the tile.
         let xs: [f32; 8] = std::array::from_fn(|i| (x0 + i.min(cols - 1)) as f32 + 0.5);
         // SAFETY: reads eight `f32`s.
-        let dx = _mm256_sub_ps(unsafe { _mm256_loadu_ps(xs.as_ptr()) }, splat(self.half_w));
+        let centres = _mm256_sub_ps(unsafe { _mm256_loadu_ps(xs.as_ptr()) }, splat(self.half_w));
         let dz = splat(self.focal);
         let m = &self.rotation;
         let one = splat(1.0);
@@ -146,7 +188,19 @@ impl RayGen {
         let (mut sy_lo, mut sy_hi) = (sx_lo, sx_hi);
         let (mut sz_lo, mut sz_hi) = (sx_lo, sx_hi);
         for r in 0..rows {
-            let dy = splat((((y0 + r) as f32) + 0.5) - self.half_h);
+            let at_row = r * cols;
+            // The pixel centres of row `r`, or the positions given (each row's eight lanes
+            // from its first ray; `at_row + 8 <= TILE_RAYS`).
+            let (dx, dy) = match positions {
+                None => (centres, splat((((y0 + r) as f32) + 0.5) - self.half_h)),
+                // SAFETY: each reads eight `f32`s inside the arrays.
+                Some((px, py)) => unsafe {
+                    (
+                        _mm256_sub_ps(_mm256_loadu_ps(px[at_row..].as_ptr()), splat(self.half_w)),
+                        _mm256_sub_ps(_mm256_loadu_ps(py[at_row..].as_ptr()), splat(self.half_h)),
+                    )
+                },
+            };
             // `Mat3 * Vec3`: x_axis·d.x + y_axis·d.y + z_axis·d.z, in that order.
             let axis = |x: f32, y: f32, z: f32| {
                 _mm256_add_ps(
@@ -266,10 +320,50 @@ mod tests {
 
     /// Every ray of tiles of four cameras and image sizes equals `RayGen::ray` bit for bit
     /// (direction, and axes and shear when shared), with AVX2 and one at a time.
+    /// Asserts that tile `t` holds rays `one` bit for bit: directions, axes, and where they are
+    /// shared the shears, their box and the padding lanes. Returns whether they share axes.
+    fn assert_tile_is(t: &RayTile, one: &[Ray], origin: Vec3, what: &str) -> bool {
+        let axes = one.iter().all(|r| r.axes() == one[0].axes());
+        assert_eq!(t.len(), one.len());
+        assert_eq!(t.origin(), origin);
+        assert_eq!(t.axes(), axes.then(|| one[0].axes()), "{what}");
+        let mut b = [f32::INFINITY, f32::NEG_INFINITY].repeat(3);
+        for (j, r) in one.iter().enumerate() {
+            let at = format!("{what}: ray {j}");
+            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+            assert_eq!(bits(t.dir(j)), bits(r.dir), "{at}");
+            let tr = t.ray(j);
+            assert_eq!(bits(tr.inv_dir), bits(r.inv_dir), "{at}");
+            assert_eq!(tr.shear().map(f32::to_bits), r.shear().map(f32::to_bits));
+            if axes {
+                let s = t.shear_lanes();
+                let s = [s[0][j], s[1][j], s[2][j]];
+                assert_eq!(s.map(f32::to_bits), r.shear().map(f32::to_bits), "{at}");
+                for k in 0..3 {
+                    b[2 * k] = b[2 * k].min(s[k]);
+                    b[2 * k + 1] = b[2 * k + 1].max(s[k]);
+                }
+            }
+        }
+        if axes {
+            assert_eq!(t.shear_box()[..], b, "{what}");
+            // The lanes past the last ray repeat it.
+            let (n, s) = (t.len(), t.shear_lanes());
+            for l in n..n.next_multiple_of(8) {
+                assert_eq!(s[0][l].to_bits(), s[0][n - 1].to_bits());
+                assert_eq!(s[2][l].to_bits(), s[2][n - 1].to_bits());
+            }
+        }
+        axes
+    }
+
+    /// Tiles through pixel centres (`tile`, on every path this CPU has) and through jittered
+    /// positions (`tile_at`, as anti-aliased frames make them) are the single rays, bit for bit.
     #[test]
     fn tiles_of_rays_are_single_rays_bit_for_bit() {
         let mut tiles = 0;
         let mut shared = 0;
+        let mut rng = crate::rng::Rng::seeded(3);
         for (i, (w, h)) in [(500, 500), (37, 91), (1920, 1080), (3, 1)]
             .into_iter()
             .enumerate()
@@ -281,63 +375,54 @@ mod tests {
             };
             let g = cam.rays(w, h);
             let (w, h) = (w as usize, h as usize);
-            let (mut fast, mut slow) = (RayTile::default(), RayTile::default());
+            let (mut fast, mut slow, mut jittered) =
+                (RayTile::default(), RayTile::default(), RayTile::default());
+            let mut avx2 = RayTile::default();
             for y0 in (0..h).step_by(8).filter(|y| y % 24 == 0 || y + 8 >= h) {
                 for x0 in (0..w).step_by(8) {
                     let (cols, rows) = ((w - x0).min(8), (h - y0).min(8));
                     g.tile(x0, y0, cols, rows, &mut fast);
                     g.tile_scalar(x0, y0, cols, rows, &mut slow);
                     tiles += 1;
+                    let pixel = |j: usize| (x0 + j % cols, y0 + j / cols);
                     let one: Vec<Ray> = (0..rows * cols)
                         .map(|j| {
-                            let (x, y) = (x0 + j % cols, y0 + j / cols);
+                            let (x, y) = pixel(j);
                             g.ray(x as f32 + 0.5, y as f32 + 0.5)
                         })
                         .collect();
-                    let axes = one.iter().all(|r| r.axes() == one[0].axes());
-                    shared += axes as usize;
-                    for t in [&fast, &slow] {
-                        assert_eq!(t.len(), one.len());
-                        assert_eq!(t.origin(), cam.position);
-                        assert_eq!(t.axes(), axes.then(|| one[0].axes()));
-                        let mut b = [f32::INFINITY, f32::NEG_INFINITY].repeat(3);
-                        for (j, r) in one.iter().enumerate() {
-                            let at = format!("{w}x{h} camera {i}: tile ({x0}, {y0}) ray {j}");
-                            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
-                            assert_eq!(bits(t.dir(j)), bits(r.dir), "{at}");
-                            let tr = t.ray(j);
-                            assert_eq!(bits(tr.inv_dir), bits(r.inv_dir), "{at}");
-                            assert_eq!(tr.shear().map(f32::to_bits), r.shear().map(f32::to_bits));
-                            if axes {
-                                let s = t.shear_lanes();
-                                let s = [s[0][j], s[1][j], s[2][j]];
-                                assert_eq!(
-                                    s.map(f32::to_bits),
-                                    r.shear().map(f32::to_bits),
-                                    "{at}"
-                                );
-                                for k in 0..3 {
-                                    b[2 * k] = b[2 * k].min(s[k]);
-                                    b[2 * k + 1] = b[2 * k + 1].max(s[k]);
-                                }
-                            }
-                        }
-                        if axes {
-                            assert_eq!(t.shear_box()[..], b, "{w}x{h} camera {i}: ({x0}, {y0})");
-                            // The lanes past the last ray repeat it.
-                            let (n, s) = (t.len(), t.shear_lanes());
-                            for l in n..n.next_multiple_of(8) {
-                                assert_eq!(s[0][l].to_bits(), s[0][n - 1].to_bits());
-                                assert_eq!(s[2][l].to_bits(), s[2][n - 1].to_bits());
-                            }
-                        }
+                    let what = format!("{w}x{h} camera {i}: tile ({x0}, {y0})");
+                    let mut paths = vec![&fast, &slow];
+                    #[cfg(target_arch = "x86_64")]
+                    if std::is_x86_feature_detected!("avx2") {
+                        // SAFETY: checked just above.
+                        unsafe { g.tile_avx2(x0, y0, cols, rows, None, &mut avx2) };
+                        paths.push(&avx2);
                     }
+                    for t in paths {
+                        shared += assert_tile_is(t, &one, cam.position, &what) as usize;
+                    }
+                    // Jittered anywhere in their pixels, corners included.
+                    let (mut px, mut py) = ([0.0; TILE_RAYS], [0.0; TILE_RAYS]);
+                    for j in 0..rows * cols {
+                        let (x, y) = pixel(j);
+                        let jitter = |rng: &mut crate::rng::Rng| match rng.next_u64() % 4 {
+                            0 => 0.0,
+                            1 => 0.999_999_94,
+                            _ => (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32,
+                        };
+                        px[j] = x as f32 + jitter(&mut rng);
+                        py[j] = y as f32 + jitter(&mut rng);
+                    }
+                    g.tile_at(cols, rows, &px, &py, &mut jittered);
+                    let one: Vec<Ray> = (0..rows * cols).map(|j| g.ray(px[j], py[j])).collect();
+                    assert_tile_is(&jittered, &one, cam.position, &format!("{what}, jittered"));
                 }
             }
         }
         // Both kinds of tiles were seen.
         assert!(
-            shared > 100 && shared < tiles,
+            shared > 100 && shared < 3 * tiles,
             "{shared} of {tiles} tiles share axes"
         );
     }

@@ -54,7 +54,8 @@ pub(super) fn by_tile(
     let bands = Mutex::new(pixels.chunks_mut(TILE * w).enumerate());
     on_every_thread(h.div_ceil(TILE), |from_back| {
         let mut n = RayCounts::default();
-        let mut tile_rays = Vec::with_capacity(TILE_RAYS);
+        let mut tile = RayTile::default();
+        let (mut px, mut py) = ([0.0; TILE_RAYS], [0.0; TILE_RAYS]);
         let mut tile_hits = [None; TILE_RAYS];
         let mut colours = [Vec3::ZERO; TILE_RAYS];
         let mut sums = [Vec3::ZERO; TILE_RAYS];
@@ -71,15 +72,15 @@ pub(super) fn by_tile(
                 let k = cols * rows;
                 sums[..k].fill(Vec3::ZERO);
                 for s in 0..samples {
-                    tile_rays.clear();
                     for i in 0..k {
                         let (x, y) = (x0 + i % cols, y0 + i / cols);
                         let pixel = (y * w + x) as u64;
                         let mut rng = Stream::for_sample(sampler, pixel, s, samples, frame);
                         let (ox, oy) = pixel_offset(&mut rng, s, samples);
-                        tile_rays.push(rays.ray(x as f32 + ox, y as f32 + oy));
+                        (px[i], py[i]) = (x as f32 + ox, y as f32 + oy);
                     }
-                    let tile = RayTile::from_rays(&tile_rays);
+                    // `rays.ray(px[i], py[i])` for each, eight at a time.
+                    rays.tile_at(cols, rows, &px, &py, &mut tile);
                     n.primary += k as u64;
                     scene.intersect_tile(
                         &tile,
