@@ -6,6 +6,7 @@ use glam::Vec3;
 
 use super::threads::{next_band, on_every_thread};
 use super::{BandDone, TILE};
+use crate::accel::tri4::Best8;
 use crate::accel::{TILE_RAYS, TileCache};
 use crate::camera::RayGen;
 use crate::geometry::RayTile;
@@ -17,18 +18,52 @@ use crate::shading::{RayCounts, TileScratch, Tracer};
 /// sampler's own offset (Sobol points are), else an s×s grid when `samples` is square, else
 /// strata in x. It draws from `rng` what the sample's offset needs.
 pub(super) fn pixel_offset(rng: &mut Stream, s: u32, samples: u32) -> (f32, f32) {
-    let strata = (samples as f32).sqrt() as u32;
-    let offset = rng.pixel_offset();
-    let [jx, jy] = offset.unwrap_or_else(|| rng.next_2d());
-    if offset.is_some() {
-        (jx, jy)
-    } else if strata * strata == samples {
-        (
-            ((s % strata) as f32 + jx) / strata as f32,
-            ((s / strata) as f32 + jy) / strata as f32,
-        )
-    } else {
-        ((s as f32 + jx) / samples as f32, jy)
+    Cell::of(s, samples).offset(rng)
+}
+
+/// The stratum of sample `s` of `samples` ([`pixel_offset`]): what every pixel's sample `s`
+/// shares, worked out once per sample rather than per pixel.
+#[derive(Clone, Copy, Debug)]
+struct Cell {
+    /// The cell's corner, in cells, on each axis.
+    x: f32,
+    y: f32,
+    /// Cells across on each axis (1 on y where the strata are in x only).
+    nx: f32,
+    ny: f32,
+}
+
+impl Cell {
+    fn of(s: u32, samples: u32) -> Cell {
+        let strata = (samples as f32).sqrt() as u32;
+        if strata * strata == samples {
+            Cell {
+                x: (s % strata) as f32,
+                y: (s / strata) as f32,
+                nx: strata as f32,
+                ny: strata as f32,
+            }
+        } else {
+            Cell {
+                x: s as f32,
+                y: 0.0,
+                nx: samples as f32,
+                ny: 1.0,
+            }
+        }
+    }
+
+    /// [`pixel_offset`] of a pixel's sample in this cell, from its numbers in `rng`: the same
+    /// operations (a cell of one on y leaves `jy` as it is: `(0 + jy) / 1` is `jy`).
+    #[inline]
+    fn offset(&self, rng: &mut Stream) -> (f32, f32) {
+        let offset = rng.pixel_offset();
+        let [jx, jy] = offset.unwrap_or_else(|| rng.next_2d());
+        if offset.is_some() {
+            (jx, jy)
+        } else {
+            ((self.x + jx) / self.nx, (self.y + jy) / self.ny)
+        }
     }
 }
 
@@ -56,7 +91,12 @@ pub(super) fn by_tile(
         let mut n = RayCounts::default();
         let mut tile = RayTile::default();
         let (mut px, mut py) = ([0.0; TILE_RAYS], [0.0; TILE_RAYS]);
+        let (mut jx, mut jy) = ([0.0; TILE_RAYS], [0.0; TILE_RAYS]);
+        let (mut fx, mut fy) = ([0.0; TILE_RAYS], [0.0; TILE_RAYS]);
         let mut tile_hits = [None; TILE_RAYS];
+        let mut tile_best = [Best8::NONE; TILE_RAYS / 8];
+        // Small scenes on AVX2: the tile kernel's hits go to shading in lanes, as they are.
+        let lanes = tracer.shades_tile_lanes();
         let mut colours = [Vec3::ZERO; TILE_RAYS];
         let mut sums = [Vec3::ZERO; TILE_RAYS];
         let mut scratch = TileScratch::default();
@@ -72,29 +112,56 @@ pub(super) fn by_tile(
                 let k = cols * rows;
                 sums[..k].fill(Vec3::ZERO);
                 for s in 0..samples {
+                    let cell = Cell::of(s, samples);
+                    // Each pixel's two numbers (the independent sampler's stream: no offset of
+                    // its own), then its place, `x + (cell + j) / cells` per axis as
+                    // `pixel_offset` has it, in a loop of its own that the compiler vectorises.
+                    for dy in 0..rows {
+                        for dx in 0..cols {
+                            let (i, x, y) = (dy * cols + dx, x0 + dx, y0 + dy);
+                            let pixel = (y * w + x) as u64;
+                            let mut rng = Stream::for_sample(sampler, pixel, s, samples, frame);
+                            debug_assert!(rng.pixel_offset().is_none());
+                            [jx[i], jy[i]] = rng.next_2d();
+                            (fx[i], fy[i]) = (x as f32, y as f32);
+                        }
+                    }
                     for i in 0..k {
-                        let (x, y) = (x0 + i % cols, y0 + i / cols);
-                        let pixel = (y * w + x) as u64;
-                        let mut rng = Stream::for_sample(sampler, pixel, s, samples, frame);
-                        let (ox, oy) = pixel_offset(&mut rng, s, samples);
-                        (px[i], py[i]) = (x as f32 + ox, y as f32 + oy);
+                        px[i] = fx[i] + (cell.x + jx[i]) / cell.nx;
+                        py[i] = fy[i] + (cell.y + jy[i]) / cell.ny;
                     }
                     // `rays.ray(px[i], py[i])` for each, eight at a time.
                     rays.tile_at(cols, rows, &px, &py, &mut tile);
                     n.primary += k as u64;
-                    scene.intersect_tile(
-                        &tile,
-                        f32::INFINITY,
-                        &mut tile_hits[..k],
-                        &mut tile_cache,
-                    );
-                    tracer.shade_tile(
-                        &tile,
-                        &tile_hits[..k],
-                        &mut colours[..k],
-                        &mut n,
-                        &mut scratch,
-                    );
+                    if lanes {
+                        scene.intersect_tile_best(
+                            &tile,
+                            f32::INFINITY,
+                            &mut tile_best,
+                            &mut tile_cache,
+                        );
+                        tracer.shade_tile_best(
+                            &tile,
+                            &tile_best,
+                            &mut colours[..k],
+                            &mut n,
+                            &mut scratch,
+                        );
+                    } else {
+                        scene.intersect_tile(
+                            &tile,
+                            f32::INFINITY,
+                            &mut tile_hits[..k],
+                            &mut tile_cache,
+                        );
+                        tracer.shade_tile(
+                            &tile,
+                            &tile_hits[..k],
+                            &mut colours[..k],
+                            &mut n,
+                            &mut scratch,
+                        );
+                    }
                     for (sum, &c) in sums[..k].iter_mut().zip(&colours[..k]) {
                         *sum += c;
                     }
