@@ -10,6 +10,7 @@ use crate::accel::tri4::Best8;
 use crate::accel::{TILE_RAYS, TileCache};
 use crate::camera::RayGen;
 use crate::geometry::RayTile;
+use crate::rng::first_two8;
 use crate::sampler::{SampleSource, Sampler, Stream};
 use crate::scene::Scene;
 use crate::shading::{RayCounts, TileScratch, Tracer};
@@ -93,6 +94,8 @@ pub(super) fn by_tile(
         let (mut px, mut py) = ([0.0; TILE_RAYS], [0.0; TILE_RAYS]);
         let (mut jx, mut jy) = ([0.0; TILE_RAYS], [0.0; TILE_RAYS]);
         let (mut fx, mut fy) = ([0.0; TILE_RAYS], [0.0; TILE_RAYS]);
+        let mut ids = [[0u64; 8]; TILE];
+        let mut numbers = [[[0f32; 8]; 2]; TILE];
         let mut tile_hits = [None; TILE_RAYS];
         let mut tile_best = [Best8::NONE; TILE_RAYS / 8];
         // Small scenes on AVX2: the tile kernel's hits go to shading in lanes, as they are.
@@ -111,19 +114,25 @@ pub(super) fn by_tile(
                 let cols = (w - x0).min(TILE);
                 let k = cols * rows;
                 sums[..k].fill(Vec3::ZERO);
+                // The tile's pixel indices by row, eight lanes each (past `cols`, the last
+                // again).
+                for (dy, row) in ids[..rows].iter_mut().enumerate() {
+                    *row = std::array::from_fn(|l| ((y0 + dy) * w + x0 + l.min(cols - 1)) as u64);
+                }
                 for s in 0..samples {
                     let cell = Cell::of(s, samples);
                     // Each pixel's two numbers (the independent sampler's stream: no offset of
                     // its own), then its place, `x + (cell + j) / cells` per axis as
                     // `pixel_offset` has it, in a loop of its own that the compiler vectorises.
-                    for dy in 0..rows {
+                    // (`Stream::for_sample`'s stream for the independent sampler is
+                    // `Rng::for_sample`'s: a row's eight pixels at a time.)
+                    debug_assert!(matches!(sampler, Sampler::Independent));
+                    first_two8(&ids[..rows], s, frame, &mut numbers[..rows]);
+                    for (dy, [rx, ry]) in numbers[..rows].iter().enumerate() {
                         for dx in 0..cols {
-                            let (i, x, y) = (dy * cols + dx, x0 + dx, y0 + dy);
-                            let pixel = (y * w + x) as u64;
-                            let mut rng = Stream::for_sample(sampler, pixel, s, samples, frame);
-                            debug_assert!(rng.pixel_offset().is_none());
-                            [jx[i], jy[i]] = rng.next_2d();
-                            (fx[i], fy[i]) = (x as f32, y as f32);
+                            let i = dy * cols + dx;
+                            (jx[i], jy[i]) = (rx[dx], ry[dx]);
+                            (fx[i], fy[i]) = ((x0 + dx) as f32, (y0 + dy) as f32);
                         }
                     }
                     for i in 0..k {
