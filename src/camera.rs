@@ -318,8 +318,6 @@ mod tests {
         assert_eq!(cam.down(), Vec3::Y);
     }
 
-    /// Every ray of tiles of four cameras and image sizes equals `RayGen::ray` bit for bit
-    /// (direction, and axes and shear when shared), with AVX2 and one at a time.
     /// Asserts that tile `t` holds rays `one` bit for bit: directions, axes, and where they are
     /// shared the shears, their box and the padding lanes. Returns whether they share axes.
     fn assert_tile_is(t: &RayTile, one: &[Ray], origin: Vec3, what: &str) -> bool {
@@ -357,8 +355,10 @@ mod tests {
         axes
     }
 
-    /// Tiles through pixel centres (`tile`, on every path this CPU has) and through jittered
-    /// positions (`tile_at`, as anti-aliased frames make them) are the single rays, bit for bit.
+    /// Every ray of tiles of four cameras and image sizes equals `RayGen::ray` bit for bit
+    /// (direction, and axes and shear when shared): through pixel centres with AVX2 (where the
+    /// CPU has it) and one at a time, and through jittered positions (`tile_at`, as
+    /// anti-aliased frames make them).
     #[test]
     fn tiles_of_rays_are_single_rays_bit_for_bit() {
         let mut tiles = 0;
@@ -377,7 +377,6 @@ mod tests {
             let (w, h) = (w as usize, h as usize);
             let (mut fast, mut slow, mut jittered) =
                 (RayTile::default(), RayTile::default(), RayTile::default());
-            let mut avx2 = RayTile::default();
             for y0 in (0..h).step_by(8).filter(|y| y % 24 == 0 || y + 8 >= h) {
                 for x0 in (0..w).step_by(8) {
                     let (cols, rows) = ((w - x0).min(8), (h - y0).min(8));
@@ -392,16 +391,8 @@ mod tests {
                         })
                         .collect();
                     let what = format!("{w}x{h} camera {i}: tile ({x0}, {y0})");
-                    let mut paths = vec![&fast, &slow];
-                    #[cfg(target_arch = "x86_64")]
-                    if std::is_x86_feature_detected!("avx2") {
-                        // SAFETY: checked just above.
-                        unsafe { g.tile_avx2(x0, y0, cols, rows, None, &mut avx2) };
-                        paths.push(&avx2);
-                    }
-                    for t in paths {
-                        shared += assert_tile_is(t, &one, cam.position, &what) as usize;
-                    }
+                    shared += assert_tile_is(&fast, &one, cam.position, &what) as usize;
+                    assert_tile_is(&slow, &one, cam.position, &what);
                     // Jittered anywhere in their pixels, corners included.
                     let (mut px, mut py) = ([0.0; TILE_RAYS], [0.0; TILE_RAYS]);
                     for j in 0..rows * cols {
@@ -422,7 +413,7 @@ mod tests {
         }
         // Both kinds of tiles were seen.
         assert!(
-            shared > 100 && shared < 3 * tiles,
+            shared > 100 && shared < tiles,
             "{shared} of {tiles} tiles share axes"
         );
     }

@@ -90,15 +90,10 @@ unsafe fn first_two8_avx512(
 ) {
     use std::arch::x86_64::*;
     let k = |c: u64| _mm512_set1_epi64(c as i64);
+    // `mix`, lane by lane.
     let mix8 = |z: __m512i| {
-        let z = _mm512_mullo_epi64(
-            _mm512_xor_si512(z, _mm512_srli_epi64::<30>(z)),
-            k(0xBF58_476D_1CE4_E5B9),
-        );
-        let z = _mm512_mullo_epi64(
-            _mm512_xor_si512(z, _mm512_srli_epi64::<27>(z)),
-            k(0x94D0_49BB_1331_11EB),
-        );
+        let z = _mm512_mullo_epi64(_mm512_xor_si512(z, _mm512_srli_epi64::<30>(z)), k(MIX_1));
+        let z = _mm512_mullo_epi64(_mm512_xor_si512(z, _mm512_srli_epi64::<27>(z)), k(MIX_2));
         _mm512_xor_si512(z, _mm512_srli_epi64::<31>(z))
     };
     // `next_f32`: the top 24 bits of the next number, times 2⁻²⁴ (both exact).
@@ -128,10 +123,14 @@ unsafe fn first_two8_avx512(
 /// Sobol sampler's seed hash).
 #[inline]
 pub(crate) fn mix(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z = (z ^ (z >> 30)).wrapping_mul(MIX_1);
+    z = (z ^ (z >> 27)).wrapping_mul(MIX_2);
     z ^ (z >> 31)
 }
+
+/// [`mix`]'s two multipliers (SplitMix64's own).
+const MIX_1: u64 = 0xBF58_476D_1CE4_E5B9;
+const MIX_2: u64 = 0x94D0_49BB_1331_11EB;
 
 #[cfg(test)]
 mod tests {

@@ -9,9 +9,10 @@ pub enum Isa {
     Sse2,
     /// Eight lanes, two blocks at a time (x86-64 CPUs from 2013 on; detected at run time).
     Avx2,
-    /// AVX2's path, with sixteen lanes where it pays: a tile's camera rays sixteen at a time
-    /// and shadow rays two triangles at a time (AVX-512 F, DQ, VL and BW: x86-64 server CPUs
-    /// from 2017 on, AMD's from Zen 4; detected at run time). The BVH's kernels are AVX2's.
+    /// AVX2's path, with sixteen lanes where it pays: a tile's camera rays sixteen at a time,
+    /// the tile's shading compiled for AVX-512, and an anti-aliased sample's random numbers
+    /// eight pixels at a time (AVX-512 F, DQ, VL and BW: x86-64 server CPUs from 2017 on, AMD's
+    /// from Zen 4; detected at run time). The BVH's kernels are AVX2's.
     Avx512,
 }
 

@@ -204,8 +204,8 @@ impl Accel {
 
     /// [`Accel::intersect_tile`], the hits as lanes: ray `i`'s is lane `i % 8` of
     /// `best[i / 8]` (lanes past the tile's rays are not to be read). The flat list on AVX2
-    /// and AVX-512 leaves them there as its kernel makes them; other structures and paths are asked for
-    /// [`Hit`]s, which are then put in lanes. The same hits either way.
+    /// and AVX-512 leaves them there as its kernel makes them; other structures and paths are
+    /// asked for [`Hit`]s, which are then put in lanes. The same hits either way.
     pub fn intersect_tile_best(
         &self,
         tile: &RayTile,

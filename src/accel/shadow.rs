@@ -180,25 +180,21 @@ impl ShadowCull {
         self.kept_with_margin(lo, hi, 1.0)
     }
 
-    /// [`ShadowCull::kept`] as a copy of its own for each `COPY` (see
-    /// [`ShadowCull::occluded8_in`]).
-    #[inline]
-    pub(crate) fn kept_in<const COPY: u8>(&self, lo: Vec3, hi: Vec3) -> u64 {
-        #[cfg(target_arch = "x86_64")]
-        let avx = std::is_x86_feature_detected!("avx");
-        #[cfg(not(target_arch = "x86_64"))]
-        let avx = false;
-        self.kept_on::<COPY>(lo, hi, 1.0, avx)
-    }
-
     /// [`ShadowCull::kept`] with the margin scaled by `scale` (1 in use; the tests show that
     /// 0 drops triangles the scalar test hits).
     pub(crate) fn kept_with_margin(&self, lo: Vec3, hi: Vec3, scale: f64) -> u64 {
+        self.kept_in::<0>(lo, hi, scale)
+    }
+
+    /// [`ShadowCull::kept_with_margin`] as a copy of its own for each `COPY` (see
+    /// [`ShadowCull::occluded8_in`]).
+    #[inline]
+    pub(crate) fn kept_in<const COPY: u8>(&self, lo: Vec3, hi: Vec3, scale: f64) -> u64 {
         #[cfg(target_arch = "x86_64")]
         let avx = std::is_x86_feature_detected!("avx");
         #[cfg(not(target_arch = "x86_64"))]
         let avx = false;
-        self.kept_on::<0>(lo, hi, scale, avx)
+        self.kept_on::<COPY>(lo, hi, scale, avx)
     }
 
     /// [`ShadowCull::kept_with_margin`], the plane tests with AVX (which the CPU must have) or

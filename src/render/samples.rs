@@ -11,7 +11,7 @@ use crate::accel::{TILE_RAYS, TileCache};
 use crate::camera::RayGen;
 use crate::geometry::RayTile;
 use crate::rng::first_two8;
-use crate::sampler::{SampleSource, Sampler, Stream};
+use crate::sampler::{SampleSource, Stream};
 use crate::scene::Scene;
 use crate::shading::{RayCounts, TileScratch, Tracer};
 
@@ -54,17 +54,20 @@ impl Cell {
         }
     }
 
-    /// [`pixel_offset`] of a pixel's sample in this cell, from its numbers in `rng`: the same
-    /// operations (a cell of one on y leaves `jy` as it is: `(0 + jy) / 1` is `jy`).
+    /// [`pixel_offset`] of a pixel's sample in this cell, from its numbers in `rng`.
     #[inline]
     fn offset(&self, rng: &mut Stream) -> (f32, f32) {
-        let offset = rng.pixel_offset();
-        let [jx, jy] = offset.unwrap_or_else(|| rng.next_2d());
-        if offset.is_some() {
-            (jx, jy)
-        } else {
-            ((self.x + jx) / self.nx, (self.y + jy) / self.ny)
+        match rng.pixel_offset() {
+            Some([jx, jy]) => (jx, jy),
+            None => self.place(rng.next_2d()),
         }
+    }
+
+    /// Where in its pixel a sample of this cell with numbers `[jx, jy]` falls (a cell of one
+    /// on y leaves `jy` as it is: `(0 + jy) / 1` is `jy`).
+    #[inline]
+    fn place(&self, [jx, jy]: [f32; 2]) -> (f32, f32) {
+        ((self.x + jx) / self.nx, (self.y + jy) / self.ny)
     }
 }
 
@@ -86,7 +89,6 @@ pub(super) fn by_tile(
     done: Option<BandDone>,
 ) -> RayCounts {
     let h = pixels.len() / w.max(1);
-    let sampler = Sampler::Independent;
     let bands = Mutex::new(pixels.chunks_mut(TILE * w).enumerate());
     on_every_thread(h.div_ceil(TILE), |from_back| {
         let mut n = RayCounts::default();
@@ -115,29 +117,30 @@ pub(super) fn by_tile(
                 let k = cols * rows;
                 sums[..k].fill(Vec3::ZERO);
                 // The tile's pixel indices by row, eight lanes each (past `cols`, the last
-                // again).
+                // again), and each pixel's corner.
                 for (dy, row) in ids[..rows].iter_mut().enumerate() {
                     *row = std::array::from_fn(|l| ((y0 + dy) * w + x0 + l.min(cols - 1)) as u64);
+                    for dx in 0..cols {
+                        let i = dy * cols + dx;
+                        (fx[i], fy[i]) = ((x0 + dx) as f32, (y0 + dy) as f32);
+                    }
                 }
                 for s in 0..samples {
                     let cell = Cell::of(s, samples);
-                    // Each pixel's two numbers (the independent sampler's stream: no offset of
-                    // its own), then its place, `x + (cell + j) / cells` per axis as
-                    // `pixel_offset` has it, in a loop of its own that the compiler vectorises.
-                    // (`Stream::for_sample`'s stream for the independent sampler is
-                    // `Rng::for_sample`'s: a row's eight pixels at a time.)
-                    debug_assert!(matches!(sampler, Sampler::Independent));
+                    // Each pixel's two numbers, from independent numbers (what
+                    // `Stream::for_sample` gives for `Sampler::Independent`, which has no
+                    // offsets of its own: `Rng::for_sample`'s), a row's eight pixels at a time;
+                    // then its place in the cell as `pixel_offset` puts it, in a loop of its own
+                    // that the compiler vectorises.
                     first_two8(&ids[..rows], s, frame, &mut numbers[..rows]);
                     for (dy, [rx, ry]) in numbers[..rows].iter().enumerate() {
-                        for dx in 0..cols {
-                            let i = dy * cols + dx;
-                            (jx[i], jy[i]) = (rx[dx], ry[dx]);
-                            (fx[i], fy[i]) = ((x0 + dx) as f32, (y0 + dy) as f32);
-                        }
+                        let at = dy * cols;
+                        jx[at..at + cols].copy_from_slice(&rx[..cols]);
+                        jy[at..at + cols].copy_from_slice(&ry[..cols]);
                     }
                     for i in 0..k {
-                        px[i] = fx[i] + (cell.x + jx[i]) / cell.nx;
-                        py[i] = fy[i] + (cell.y + jy[i]) / cell.ny;
+                        let (ox, oy) = cell.place([jx[i], jy[i]]);
+                        (px[i], py[i]) = (fx[i] + ox, fy[i] + oy);
                     }
                     // `rays.ray(px[i], py[i])` for each, eight at a time.
                     rays.tile_at(cols, rows, &px, &py, &mut tile);

@@ -86,8 +86,8 @@ impl Default for LaneScratch {
 }
 
 impl Tracer<'_> {
-    /// Whether [`Tracer::shade_tile_lanes`] shades this frame's tiles: AVX2 queries and a scene
-    /// small enough for the shadow cull.
+    /// Whether [`Tracer::shade_tile_lanes`] shades this frame's tiles: AVX2 or AVX-512 queries
+    /// and a scene small enough for the shadow cull.
     pub(super) fn shades_in_lanes(&self) -> bool {
         matches!(self.scene.isa(), Isa::Avx2 | Isa::Avx512)
             && self.scene.triangles().len() <= SHADOW_TILE_TRIANGLES
@@ -268,7 +268,7 @@ impl Tracer<'_> {
                 if count > 0 {
                     let cull = &tables.culls[li];
                     let (lo, hi) = origin_box::<COPY>(s, &traced[..chunks]);
-                    let kept = cull.kept_in::<COPY>(lo, hi);
+                    let kept = cull.kept_in::<COPY>(lo, hi, 1.0);
                     for c in 0..chunks {
                         if traced[c] != 0 {
                             blocked[c] = shadows8::<COPY>(s, cull, kept, 8 * c, traced[c], t_max);
