@@ -26,13 +26,15 @@ pub mod rng;
 pub mod sampler;
 pub mod scene;
 pub mod shading;
+mod text;
 
 pub use accel::{AccelKind, AccelStats, Hit};
 pub use camera::Camera;
-pub use frame::{CellGrid, ColorMode, encode_diff, encode_text, printable};
+pub use frame::{CellGrid, ColorMode, encode_diff, encode_text};
 pub use geometry::{Ray, Triangle};
 pub use image::Image;
 pub use render::{Frame, FrameStats, HitCache, render, render_cached, render_guided};
 pub use scene::cornell::cornell_box;
 pub use scene::{Effects, Indirect, Material, PointLight, Scene, SceneBuilder};
 pub use shading::{Mode, RayCounts, Settings, Stage, Tracer};
+pub use text::printable;

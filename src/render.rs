@@ -13,8 +13,7 @@ use rayon::prelude::*;
 mod samples;
 mod threads;
 
-pub use threads::spin_until_work;
-use threads::{next_band, on_every_thread, work_shared_out};
+use threads::{next_band, on_every_thread};
 
 use crate::accel::tri4::Best8;
 use crate::accel::{Hit, TILE_RAYS, TileCache};
@@ -436,7 +435,6 @@ fn render_impl(
             done,
         )
     } else {
-        work_shared_out();
         image
             .pixels
             .par_chunks_mut(w)

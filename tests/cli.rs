@@ -573,8 +573,8 @@ fn long_help_lists_the_app_keys() {
 }
 
 /// Without `RAYON_NUM_THREADS`, a frame runs on as many threads as the CPUs the process may run
-/// on (its affinity mask, as `nproc` counts: the binary reads the mask itself rather than
-/// rayon's default), here one CPU and all of them; with it, on as many as it says.
+/// on (rayon's default, std's `available_parallelism`: the affinity mask, as `nproc` counts, and
+/// any CPU quota), here one CPU and all of them; with it, on as many as it says.
 #[cfg(target_os = "linux")]
 #[test]
 fn the_pool_has_a_thread_per_cpu_of_the_affinity_mask() {
@@ -629,4 +629,40 @@ fn the_pool_has_a_thread_per_cpu_of_the_affinity_mask() {
     assert_eq!(threads(false, None), cpus);
     assert_eq!(threads(true, None), 1);
     assert_eq!(threads(true, Some("3")), 3);
+}
+
+/// Under a CPU quota of half a CPU (a cgroup v1 `cpu` group, as containers set), a frame runs
+/// on one thread: rayon's default count respects the quota. Needs root and cgroup v1's `cpu`
+/// controller at /sys/fs/cgroup/cpu; elsewhere it says so and checks nothing.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_half_cpu_quota_gives_one_thread() {
+    let group = std::path::Path::new("/sys/fs/cgroup/cpu")
+        .join(format!("raytty-test-{}", std::process::id()));
+    if std::fs::create_dir(&group).is_err() {
+        eprintln!("no cgroup v1 cpu controller to write to: not checked");
+        return;
+    }
+    let set = |file: &str, value: &str| std::fs::write(group.join(file), value).is_ok();
+    let ok = set("cpu.cfs_period_us", "100000") && set("cpu.cfs_quota_us", "50000");
+    let out = ok.then(|| {
+        Command::new("sh")
+            .arg("-c")
+            .arg(format!(
+                "echo $$ > {}/cgroup.procs && exec \"$0\" render --pixels 8x8 --format ascii --stats=json",
+                group.display()
+            ))
+            .arg(env!("CARGO_BIN_EXE_raytty"))
+            .env_remove("RAYON_NUM_THREADS")
+            .output()
+            .unwrap()
+    });
+    let _ = std::fs::remove_dir(&group);
+    let Some(out) = out else {
+        eprintln!("cannot set a CPU quota: not checked");
+        return;
+    };
+    assert!(out.status.success(), "{out:?}");
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("\"threads\":1"), "{err}");
 }

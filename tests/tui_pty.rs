@@ -348,6 +348,43 @@ fn c_cycles_the_colour_mode_live() {
     s.wait_for_status(&["ascii"]);
 }
 
+/// A panic in the app (forced by a debug build's `RAYTTY_TEST_PANIC`) restores the terminal
+/// before std's message, which names the panic, and exits with std's status for it, 101.
+#[test]
+fn a_panic_restores_the_terminal_and_exits_101() {
+    let pair = native_pty_system()
+        .openpty(PtySize {
+            rows: 10,
+            cols: 30,
+            pixel_width: 0,
+            pixel_height: 0,
+        })
+        .expect("open a pty");
+    let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_raytty"));
+    cmd.env("TERM", "xterm-256color");
+    cmd.env("RAYTTY_TEST_PANIC", "1");
+    let mut child = pair.slave.spawn_command(cmd).expect("spawn raytty");
+    drop(pair.slave);
+    let mut reader = pair.master.try_clone_reader().expect("pty reader");
+    let mut raw = Vec::new();
+    let mut buf = [0u8; 4096];
+    while let Ok(n @ 1..) = reader.read(&mut buf) {
+        raw.extend_from_slice(&buf[..n]);
+        if child.try_wait().expect("query the child").is_some() {
+            break;
+        }
+    }
+    let status = child.wait().expect("wait for raytty");
+    let text = String::from_utf8_lossy(&raw);
+    let panicked = text.find("RAYTTY_TEST_PANIC is set").expect(&text);
+    let left = text
+        .rfind("\x1b[?1049l")
+        .expect("the alternate screen is left");
+    assert!(left < panicked, "restored after the message: {text:?}");
+    assert!(text.contains("panicked at"), "{text:?}");
+    assert_eq!(status.exit_code(), 101, "{text:?}");
+}
+
 #[test]
 fn sigterm_restores_the_terminal() {
     let mut s = Session::start(30, 10, false);

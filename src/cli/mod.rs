@@ -3,8 +3,6 @@
 //! input (clap's own usage errors are 2 as well), and for the app 128 + N after signal N
 //! ([`signal_status`]; a dropped terminal counts as SIGHUP).
 
-#[cfg(target_os = "linux")]
-mod alloc;
 mod args;
 mod bench;
 mod progress;
@@ -24,16 +22,11 @@ use render::{RenderColor, run_render, text_format, without_os_error};
 
 /// Parses the command line, runs it, and maps the outcome to an exit status.
 pub fn main() -> u8 {
-    #[allow(unused_mut)]
-    let mut cmd = Cli::command();
-    // The app's keys, under `--help` (and `help`): built only when asked for.
+    let cmd = Cli::command();
+    // The app's keys, under `--help` (and `help`).
     #[cfg(feature = "tui")]
-    if std::env::args_os()
-        .skip(1)
-        .any(|a| a == "--help" || a == "help")
-    {
-        cmd = cmd.after_long_help(crate::tui::keys::help_text());
-    }
+    let cmd = cmd.after_long_help(crate::tui::keys::help_text());
+    let mut cmd = cmd;
     let matches = cmd.get_matches_mut();
     global_conflicts(&mut cmd, &matches).unwrap_or_else(|e| e.exit());
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());

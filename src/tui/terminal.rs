@@ -414,6 +414,12 @@ fn event_loop(mut app: App, rx: &Receiver<Input>, writer: &Sender<Job>) -> Resul
             stale = false;
             last_draw = Instant::now();
             let bytes = screen.draw(&app);
+            // Debug builds only: a test's way to make the app panic with the terminal taken
+            // (`tests/tui_pty.rs`: restored first, then std's message and status 101).
+            #[cfg(debug_assertions)]
+            if std::env::var_os("RAYTTY_TEST_PANIC").is_some() {
+                panic!("RAYTTY_TEST_PANIC is set");
+            }
             if !bytes.is_empty() {
                 let job = Job {
                     epoch: tty::epoch(),

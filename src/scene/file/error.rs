@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-use crate::frame::printable;
+use crate::text::printable;
 
 /// A mistake in a scene file or in a mesh it names.
 #[derive(Clone, Debug, PartialEq, Eq)]
