@@ -3,6 +3,7 @@
 use glam::{Mat3, Vec3};
 
 use crate::geometry::{Ray, RayTile, TILE_RAYS};
+use crate::simd::Isa;
 
 /// A pinhole camera at `position`, turned by `yaw` about the y axis (y points down) and tilted
 /// by `pitch` about its right axis. With yaw = pitch = 0 it looks along +z.
@@ -97,15 +98,24 @@ impl RayGen {
     /// Makes `out` the tile of rays through the centres of pixels `x0..x0 + cols` of rows
     /// `y0..y0 + rows` (`cols`, `rows` ≤ 8), ray `r·cols + c` through pixel (x0 + c, y0 + r):
     /// each is `self.ray(x + 0.5, y + 0.5)` bit for bit, with its shear when the tile's rays
-    /// share their axes. Made eight at a time with AVX2 where the CPU has it (the same
-    /// operations in the same order, so the same rounding).
-    pub fn tile(&self, x0: usize, y0: usize, cols: usize, rows: usize, out: &mut RayTile) {
+    /// share their axes. Made eight at a time on the AVX2 and AVX-512 paths (the same
+    /// operations in the same order, so the same rounding); `isa` must be available.
+    pub fn tile(
+        &self,
+        isa: Isa,
+        x0: usize,
+        y0: usize,
+        cols: usize,
+        rows: usize,
+        out: &mut RayTile,
+    ) {
         assert!(
             (1..=8).contains(&cols) && (1..=8).contains(&rows),
             "a tile is 1 to 8 pixels on a side"
         );
         #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
+        if matches!(isa, Isa::Avx2 | Isa::Avx512) {
+            assert!(isa.available(), "{} is not available", isa.name());
             // SAFETY: the CPU has AVX2 (checked above).
             unsafe { self.tile_avx2(x0, y0, cols, rows, None, out) };
             return;
@@ -116,9 +126,11 @@ impl RayGen {
     /// Makes `out` the tile of `cols`×`rows` rays (`cols`, `rows` ≤ 8) through image positions
     /// `(px[i], py[i])` in pixels, ray `r·cols + c` being `i = r·cols + c`: each is
     /// `self.ray(px[i], py[i])` bit for bit (an anti-aliased frame's jittered rays), made eight
-    /// at a time with AVX2 where the CPU has it. Entries from `rows·cols` on are ignored.
+    /// at a time on the AVX2 and AVX-512 paths (`isa` must be available). Entries from
+    /// `rows·cols` on are ignored.
     pub fn tile_at(
         &self,
+        isa: Isa,
         cols: usize,
         rows: usize,
         px: &[f32; TILE_RAYS],
@@ -130,7 +142,8 @@ impl RayGen {
             "a tile is 1 to 8 pixels on a side"
         );
         #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
+        if matches!(isa, Isa::Avx2 | Isa::Avx512) {
+            assert!(isa.available(), "{} is not available", isa.name());
             // The lanes past the last ray repeat it, so that every lane is a ray of the tile.
             let n = rows * cols;
             let (mut px, mut py) = (*px, *py);
@@ -380,7 +393,7 @@ mod tests {
             for y0 in (0..h).step_by(8).filter(|y| y % 24 == 0 || y + 8 >= h) {
                 for x0 in (0..w).step_by(8) {
                     let (cols, rows) = ((w - x0).min(8), (h - y0).min(8));
-                    g.tile(x0, y0, cols, rows, &mut fast);
+                    g.tile(Isa::detect(), x0, y0, cols, rows, &mut fast);
                     g.tile_scalar(x0, y0, cols, rows, &mut slow);
                     tiles += 1;
                     let pixel = |j: usize| (x0 + j % cols, y0 + j / cols);
@@ -405,7 +418,7 @@ mod tests {
                         px[j] = x as f32 + jitter(&mut rng);
                         py[j] = y as f32 + jitter(&mut rng);
                     }
-                    g.tile_at(cols, rows, &px, &py, &mut jittered);
+                    g.tile_at(Isa::detect(), cols, rows, &px, &py, &mut jittered);
                     let one: Vec<Ray> = (0..rows * cols).map(|j| g.ray(px[j], py[j])).collect();
                     assert_tile_is(&jittered, &one, cam.position, &format!("{what}, jittered"));
                 }

@@ -26,6 +26,7 @@ pub mod rng;
 pub mod sampler;
 pub mod scene;
 pub mod shading;
+pub mod simd;
 mod text;
 
 pub use accel::{AccelKind, AccelStats, Hit};

@@ -326,7 +326,7 @@ fn render_impl(
                     let cols = (w - x0).min(TILE);
                     // The tile's row `dy` (`cols` rays from `dy·cols`) in the band's rows.
                     let row = |dy: usize| dy * w + x0..dy * w + x0 + cols;
-                    rays.tile(x0, y0, cols, rows, &mut tile_rays);
+                    rays.tile(scene.isa(), x0, y0, cols, rows, &mut tile_rays);
                     let k = tile_rays.len();
                     let colours = &mut tile_colours[..k];
                     if lanes {

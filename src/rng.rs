@@ -1,6 +1,8 @@
 //! A small, seedable random number generator. Every sample's stream is derived from
 //! (pixel, sample, frame), so images do not depend on the thread count or the order of work.
 
+use crate::simd::Isa;
+
 /// The generator's increment: 2⁶⁴/φ, odd, so the state visits every 64-bit value.
 const GOLDEN: u64 = 0x9E37_79B9_7F4A_7C15;
 
@@ -55,13 +57,20 @@ impl Rng {
 
 /// The first two numbers of sample `sample` of rows of eight pixels in frame `frame`: for row
 /// `r`, `Rng::for_sample(pixels[r][l], sample, frame)`'s first two `next_f32`s in lane `l` of
-/// `out[r][0]` and `out[r][1]`, bit for bit. With AVX-512 (its 64-bit multiply) eight lanes at
-/// a time, the rows' hashes in flight together, where the CPU has it; else one pixel after
-/// the other.
-pub fn first_two8(pixels: &[[u64; 8]], sample: u32, frame: u32, out: &mut [[[f32; 8]; 2]]) {
+/// `out[r][0]` and `out[r][1]`, bit for bit. On the AVX-512 path (its 64-bit multiply) eight
+/// lanes at a time, the rows' hashes in flight together; else one pixel after the other.
+/// `isa` must be available.
+pub fn first_two8(
+    isa: Isa,
+    pixels: &[[u64; 8]],
+    sample: u32,
+    frame: u32,
+    out: &mut [[[f32; 8]; 2]],
+) {
     assert_eq!(pixels.len(), out.len());
     #[cfg(target_arch = "x86_64")]
-    if crate::accel::Isa::Avx512.available() {
+    if isa == Isa::Avx512 {
+        assert!(isa.available(), "{} is not available", isa.name());
         // SAFETY: the CPU has AVX-512 (checked above).
         unsafe { first_two8_avx512(pixels, sample, frame, out) };
         return;
@@ -180,8 +189,8 @@ mod tests {
     }
 
     /// Rows of eight pixels' first two numbers at once are each pixel's own, bit for bit (on
-    /// this CPU's path: the AVX-512 one where it is there), for pixels, samples and frames
-    /// across the whole range of their bits.
+    /// every path this CPU has), for pixels, samples and frames across the whole range of their
+    /// bits.
     #[test]
     fn first_two_numbers_of_eight_pixels_are_each_ones() {
         let mut seeds = Rng::seeded(9);
@@ -198,17 +207,20 @@ mod tests {
             for (r, row) in all.iter_mut().enumerate() {
                 *row = pixels.map(|p| p.wrapping_add(r as u64 * 1000));
             }
-            let mut got = vec![[[0.0; 8]; 2]; rows];
-            first_two8(&all, sample, frame, &mut got);
-            for (row, got) in all.iter().zip(&got) {
-                for (l, &p) in row.iter().enumerate() {
-                    let mut r = Rng::for_sample(p, sample, frame);
-                    let want = [r.next_f32(), r.next_f32()];
-                    assert_eq!(
-                        [got[0][l].to_bits(), got[1][l].to_bits()],
-                        want.map(f32::to_bits),
-                        "pixel {p}, sample {sample}, frame {frame}"
-                    );
+            for isa in Isa::ALL.into_iter().filter(|i| i.available()) {
+                let mut got = vec![[[0.0; 8]; 2]; rows];
+                first_two8(isa, &all, sample, frame, &mut got);
+                for (row, got) in all.iter().zip(&got) {
+                    for (l, &p) in row.iter().enumerate() {
+                        let mut r = Rng::for_sample(p, sample, frame);
+                        let want = [r.next_f32(), r.next_f32()];
+                        assert_eq!(
+                            [got[0][l].to_bits(), got[1][l].to_bits()],
+                            want.map(f32::to_bits),
+                            "{}: pixel {p}, sample {sample}, frame {frame}",
+                            isa.name()
+                        );
+                    }
                 }
             }
         }

@@ -23,10 +23,7 @@ const LAYERS: &[&[&str]] = &[
 ];
 
 /// Known exceptions, each until the change named: (module, what it uses).
-const NOT_YET: &[(&str, &str)] = &[
-    // `rng` asks `accel::Isa` for AVX-512 until `Isa` moves to `simd` (issue 20).
-    ("rng", "accel"),
-];
+const NOT_YET: &[(&str, &str)] = &[];
 
 fn layer_of(module: &str) -> Option<usize> {
     LAYERS.iter().position(|l| l.contains(&module))

@@ -277,7 +277,7 @@ fn shadow_lanes_answer_as_the_scalar_test() {
             } else {
                 (1 << tris.len()) - 1
             };
-            for kept in [all, cull.kept(lo, hi)] {
+            for kept in [all, cull.kept(Isa::detect(), lo, hi)] {
                 // SAFETY: as above.
                 let blocked =
                     unsafe { cull.occluded8_avx2(kept, &p, lanes, oz, t_max, |l| *packet[l]) };

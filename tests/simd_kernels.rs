@@ -437,7 +437,14 @@ fn tiles_of_rays_on_every_path_match_brute_force() {
                 (rng.next_u64() % 45) as usize,
             );
             let mut tile = RayTile::default();
-            g.tile(x0, y0, (61 - x0).min(8), (45 - y0).min(8), &mut tile);
+            g.tile(
+                Isa::detect(),
+                x0,
+                y0,
+                (61 - x0).min(8),
+                (45 - y0).min(8),
+                &mut tile,
+            );
             (tile, f32::INFINITY)
         })
         .collect();

@@ -29,13 +29,13 @@ mod wide;
 use std::mem::MaybeUninit;
 
 use super::hit::{Hit, cull_bound};
-use super::isa::Isa;
 #[cfg(target_arch = "x86_64")]
 use super::tri4::{Avx2, Sse2};
 use super::tri4::{
     Closest, Kernel, LANES, Portable, RayLanes, Tri4, blocks_closest, blocks_occluded,
 };
 use crate::geometry::{Ray, RayTile, Triangle};
+use crate::simd::Isa;
 use node::{Node, NodePair};
 use wide::{LEAF, TreeStats, WIDTH, Wide, WideBoxes, leaf_blocks};
 

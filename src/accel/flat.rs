@@ -9,10 +9,10 @@ use std::ops::Range;
 
 use super::box4::Box4;
 use super::hit::{Hit, cull_bound};
-use super::isa::Isa;
 use super::tri4::{
     Best8, Closest, Kernel, LANES, Portable, RayLanes, Tri4, blocks_closest, blocks_occluded,
 };
+use crate::simd::Isa;
 use glam::Vec3;
 
 use crate::geometry::{Aabb, Ray, RayTile, TILE_RAYS, Triangle};

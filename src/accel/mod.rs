@@ -20,7 +20,6 @@ pub mod box8;
 pub mod bvh;
 mod flat;
 mod hit;
-mod isa;
 pub mod shadow;
 pub mod tri4;
 
@@ -32,10 +31,10 @@ use bvh::Bvh;
 use flat::Flat;
 
 pub use crate::geometry::TILE_RAYS;
+pub use crate::simd::Isa;
 pub(crate) use bvh::prefetch_value;
 pub use flat::TileCache;
 pub use hit::{CULL_SLACK, Hit, cull_bound, shrunk_t_max};
-pub use isa::Isa;
 
 /// Scenes with at least this many triangles get a BVH; smaller ones the flat object list.
 ///

@@ -51,6 +51,7 @@
 use glam::Vec3;
 
 use crate::geometry::{Triangle, gamma};
+use crate::simd::Isa;
 
 #[cfg(target_arch = "x86_64")]
 use super::tri4::shadow::any_hit8_in;
@@ -175,25 +176,25 @@ impl ShadowCull {
     }
 
     /// The triangles some ray from an origin in the box `lo`..`hi` toward the light may hit,
-    /// as a bit per triangle (bit `i`: the scene's triangle `i`).
-    pub fn kept(&self, lo: Vec3, hi: Vec3) -> u64 {
-        self.kept_with_margin(lo, hi, 1.0)
+    /// as a bit per triangle (bit `i`: the scene's triangle `i`), the plane tests on path `isa`
+    /// (which must be available).
+    pub fn kept(&self, isa: Isa, lo: Vec3, hi: Vec3) -> u64 {
+        self.kept_with_margin(isa, lo, hi, 1.0)
     }
 
     /// [`ShadowCull::kept`] with the margin scaled by `scale` (1 in use; the tests show that
     /// 0 drops triangles the scalar test hits).
-    pub(crate) fn kept_with_margin(&self, lo: Vec3, hi: Vec3, scale: f64) -> u64 {
-        self.kept_in::<0>(lo, hi, scale)
+    pub(crate) fn kept_with_margin(&self, isa: Isa, lo: Vec3, hi: Vec3, scale: f64) -> u64 {
+        self.kept_in::<0>(isa, lo, hi, scale)
     }
 
     /// [`ShadowCull::kept_with_margin`] as a copy of its own for each `COPY` (see
     /// [`ShadowCull::occluded8_in`]).
     #[inline]
-    pub(crate) fn kept_in<const COPY: u8>(&self, lo: Vec3, hi: Vec3, scale: f64) -> u64 {
-        #[cfg(target_arch = "x86_64")]
-        let avx = std::is_x86_feature_detected!("avx");
-        #[cfg(not(target_arch = "x86_64"))]
-        let avx = false;
+    pub(crate) fn kept_in<const COPY: u8>(&self, isa: Isa, lo: Vec3, hi: Vec3, scale: f64) -> u64 {
+        // AVX2 implies AVX.
+        let avx = matches!(isa, Isa::Avx2 | Isa::Avx512);
+        assert!(isa.available(), "{} is not available", isa.name());
         self.kept_on::<COPY>(lo, hi, scale, avx)
     }
 
@@ -452,7 +453,7 @@ mod tests {
             let cull = ShadowCull::new(&[tri], light);
             let h = hits(&v, o, light);
             hit += h as usize;
-            if h && cull.kept_with_margin(lo, hi, scale) & 1 == 0 {
+            if h && cull.kept_with_margin(Isa::detect(), lo, hi, scale) & 1 == 0 {
                 wrong += 1;
             }
         }
@@ -497,9 +498,8 @@ mod tests {
             let h = point(&mut rng, [0.0, 0.01, 0.1][case % 3]).abs();
             let (lo, hi) = (c - h, c + h);
             let cull = ShadowCull::new(&tris, light);
-            let kept = cull.kept(lo, hi);
-            #[cfg(target_arch = "x86_64")]
-            if std::is_x86_feature_detected!("avx") {
+            let kept = cull.kept(Isa::detect(), lo, hi);
+            if Isa::Avx2.available() {
                 assert_eq!(
                     cull.kept_on::<0>(lo, hi, 1.0, true),
                     cull.kept_on::<0>(lo, hi, 1.0, false)

@@ -6,6 +6,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
 use raytty::sampler::Sampler;
 use raytty::scene::MAX_COORDINATE;
+use raytty::simd::Isa;
 use raytty::{ColorMode, Stage};
 
 /// Renders the Cornell box (or another scene) by ray tracing, in the terminal.
@@ -178,6 +179,10 @@ pub(super) struct RenderArgs {
     /// spp, rays, mrays_per_s, simd, threads).
     #[arg(long, value_name = "FORMAT", num_args = 0..=1, require_equals = true, default_missing_value = "text")]
     pub(super) stats: Option<StatsFormat>,
+    /// The SIMD path: portable, sse2, avx2 or avx512 (default: the widest this CPU has). Every
+    /// path gives the same frame; this is for checking that.
+    #[arg(long, value_name = "PATH", value_parser = parse_simd, hide = true)]
+    pub(super) simd: Option<Isa>,
 }
 
 /// How `render --stats` prints the frame's cost.
@@ -187,6 +192,13 @@ pub(super) enum StatsFormat {
     Text,
     /// One JSON object.
     Json,
+}
+
+pub(super) fn parse_simd(s: &str) -> Result<Isa, String> {
+    Isa::ALL
+        .into_iter()
+        .find(|isa| isa.name() == s)
+        .ok_or_else(|| format!("'{s}' is not a SIMD path: expected portable, sse2, avx2 or avx512"))
 }
 
 pub(super) fn parse_size(s: &str) -> Result<(u32, u32), String> {

@@ -225,6 +225,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<u8> 
             light: None,
             output: None,
             stats: None,
+            simd: None,
         },
         scene,
         false,

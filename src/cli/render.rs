@@ -83,7 +83,22 @@ pub(super) fn run_render(
             pixels * 48 / (1024 * 1024)
         );
     }
-    let scene = crate::cli::scene_arg::load_scene(scene)?;
+    let mut scene = crate::cli::scene_arg::load_scene(scene)?;
+    if let Some(isa) = args.simd {
+        let available: Vec<_> = raytty::simd::Isa::ALL
+            .into_iter()
+            .filter(|i| i.available())
+            .map(|i| i.name())
+            .collect();
+        scene = match scene.with_isa(isa) {
+            Some(s) => s,
+            None => usage!(
+                "--simd {}: this CPU does not have that path (it has {})",
+                isa.name(),
+                available.join(", ")
+            ),
+        };
+    }
     let mut camera = scene.camera();
     if let Some([x, y, z, yaw]) = args.camera {
         camera.position = Vec3::new(x, y, z);

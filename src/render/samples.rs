@@ -132,7 +132,7 @@ pub(super) fn by_tile(
                     // offsets of its own: `Rng::for_sample`'s), a row's eight pixels at a time;
                     // then its place in the cell as `pixel_offset` puts it, in a loop of its own
                     // that the compiler vectorises.
-                    first_two8(&ids[..rows], s, frame, &mut numbers[..rows]);
+                    first_two8(scene.isa(), &ids[..rows], s, frame, &mut numbers[..rows]);
                     for (dy, [rx, ry]) in numbers[..rows].iter().enumerate() {
                         let at = dy * cols;
                         jx[at..at + cols].copy_from_slice(&rx[..cols]);
@@ -143,7 +143,7 @@ pub(super) fn by_tile(
                         (px[i], py[i]) = (fx[i] + ox, fy[i] + oy);
                     }
                     // `rays.ray(px[i], py[i])` for each, eight at a time.
-                    rays.tile_at(cols, rows, &px, &py, &mut tile);
+                    rays.tile_at(scene.isa(), cols, rows, &px, &py, &mut tile);
                     n.primary += k as u64;
                     if lanes {
                         scene.intersect_tile_best(

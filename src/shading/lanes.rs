@@ -268,7 +268,7 @@ impl Tracer<'_> {
                 if count > 0 {
                     let cull = &tables.culls[li];
                     let (lo, hi) = origin_box::<COPY>(s, &traced[..chunks]);
-                    let kept = cull.kept_in::<COPY>(lo, hi, 1.0);
+                    let kept = cull.kept_in::<COPY>(self.scene.isa(), lo, hi, 1.0);
                     for c in 0..chunks {
                         if traced[c] != 0 {
                             blocked[c] = shadows8::<COPY>(s, cull, kept, 8 * c, traced[c], t_max);

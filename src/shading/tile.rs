@@ -1,13 +1,14 @@
 //! The per-light arithmetic of [`Tracer::shade_tile`] eight pixels at a time: each pixel's
 //! unshadowed term and shadow ray exactly as [`Tracer::light_term`] computes them (the same
 //! `f32` operations in the same order, no fused multiply-add; the next-float steps of
-//! `offset_ray_origin` as integer steps on the bits), with AVX2 where the CPU has it.
+//! `offset_ray_origin` as integer steps on the bits), with AVX2 on the AVX2 and AVX-512 paths.
 
 use glam::Vec3;
 
 use super::Tracer;
 use crate::geometry::Ray;
 use crate::scene::PointLight;
+use crate::simd::Isa;
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::__m256;
 
@@ -21,9 +22,9 @@ impl Tracer<'_> {
     /// [`Tracer::light_term`] of `light` for every pixel of `at`, appended to `out` in order.
     pub(super) fn light_terms(&self, light: &PointLight, at: &[At], out: &mut Vec<Term>) {
         #[cfg(target_arch = "x86_64")]
-        if light.power != Vec3::ZERO && std::is_x86_feature_detected!("avx2") {
+        if light.power != Vec3::ZERO && matches!(self.scene.isa(), Isa::Avx2 | Isa::Avx512) {
             for chunk in at.chunks(8) {
-                // SAFETY: the CPU has AVX2 (checked above).
+                // SAFETY: the CPU has AVX2 (the scene's path is only set where it is available).
                 unsafe { self.light_terms8_avx2(light, chunk, out) };
             }
             return;

@@ -25,8 +25,8 @@ use glam::Vec3;
 
 use super::box4::Box4;
 use super::hit::Hit;
-use super::isa::Isa;
 use crate::geometry::{Ray, RayTile};
+use crate::simd::Isa;
 
 mod portable;
 mod search;
