@@ -5,16 +5,24 @@ use glam::{Mat3, Vec3};
 use crate::geometry::{Ray, RayTile, TILE_RAYS};
 use crate::simd::Isa;
 
-/// A pinhole camera at `position`, turned by `yaw` about the y axis (y points down) and tilted
-/// by `pitch` about its right axis. With yaw = pitch = 0 it looks along +z.
+/// A pinhole camera at `position`, turned by `yaw` about its frame's down axis and tilted by
+/// `pitch` about its right axis. In the seed's frame (the identity: x right, y down, z forward,
+/// the Cornell box's axes) yaw = pitch = 0 looks along +z.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Eye position.
     pub position: Vec3,
-    /// Rotation about y in radians; positive turns towards +x (to the right).
+    /// Rotation about the frame's down axis in radians; positive turns to the right.
     pub yaw: f32,
-    /// Rotation about the camera's right axis in radians; positive looks down (+y).
+    /// Rotation about the camera's right axis in radians; positive looks down.
     pub pitch: f32,
+    /// The frame yaw and pitch turn within: its columns are the camera's right, down and
+    /// forward axes at yaw = pitch = 0, orthonormal with right × down = forward. The identity
+    /// for the seed's box; [`Camera::look_at`] makes one whose down axis is the scene's −up.
+    pub frame: Mat3,
+    /// Vertical field of view in radians, in (0, π); `None` for the seed's rule (focal length
+    /// = the shorter image side, 2·atan(½) ≈ 53.13° across it).
+    pub fov: Option<f32>,
 }
 
 impl Default for Camera {
@@ -24,21 +32,77 @@ impl Default for Camera {
             position: Vec3::new(0.0, 0.0, -3.0),
             yaw: 0.0,
             pitch: 0.0,
+            frame: Mat3::IDENTITY,
+            fov: None,
         }
     }
 }
 
+/// Smallest and largest vertical field of view accepted, in degrees (`--fov`, file cameras).
+pub const FOV_RANGE_DEGREES: (f32, f32) = (1.0, 170.0);
+
 impl Camera {
-    /// The seed's rotation R = [[cos θ, 0, sin θ], [0, 1, 0], [−sin θ, 0, cos θ]] times the pitch.
+    /// A camera at `from` looking at `at`, `up` pointing up on screen (yaw 0; the pitch says
+    /// how far it looks up or down), with vertical field of view `fov` in radians. Looking
+    /// straight along `up`, the screen's up is picked perpendicular to it. `None` when `from`
+    /// and `at` are the same point, `up` is zero or any value is not finite.
+    pub fn look_at(from: Vec3, at: Vec3, up: Vec3, fov: Option<f32>) -> Option<Camera> {
+        let d = (at - from).normalize_or_zero();
+        let up = up.normalize_or_zero();
+        if d == Vec3::ZERO || up == Vec3::ZERO || !from.is_finite() {
+            return None;
+        }
+        let down = -up;
+        // Forward at pitch 0: the view direction flattened onto the plane across `up`.
+        let mut flat = (d - up * d.dot(up)).normalize_or_zero();
+        if flat == Vec3::ZERO {
+            flat = up.any_orthonormal_vector();
+        }
+        let right = down.cross(flat);
+        let pitch = libm::asinf(d.dot(down).clamp(-1.0, 1.0));
+        Some(Camera {
+            position: from,
+            yaw: 0.0,
+            pitch,
+            frame: Mat3::from_cols(right, down, flat),
+            fov,
+        })
+    }
+
+    /// The camera's rotation: its frame times the seed's yaw R = [[cos θ, 0, sin θ], [0, 1, 0],
+    /// [−sin θ, 0, cos θ]] times the pitch (the identity frame is not multiplied: the seed's
+    /// rotations stay bit for bit).
     pub fn rotation(&self) -> Mat3 {
         let (s, c) = (libm::sinf(self.yaw), libm::cosf(self.yaw));
-        let yaw = Mat3::from_cols(Vec3::new(c, 0.0, -s), Vec3::Y, Vec3::new(s, 0.0, c));
-        if self.pitch == 0.0 {
-            return yaw;
+        let mut r = Mat3::from_cols(Vec3::new(c, 0.0, -s), Vec3::Y, Vec3::new(s, 0.0, c));
+        if self.pitch != 0.0 {
+            let (s, c) = (libm::sinf(self.pitch), libm::cosf(self.pitch));
+            r *= Mat3::from_cols(Vec3::X, Vec3::new(0.0, c, -s), Vec3::new(0.0, s, c));
         }
-        let (s, c) = (libm::sinf(self.pitch), libm::cosf(self.pitch));
-        let pitch = Mat3::from_cols(Vec3::X, Vec3::new(0.0, c, -s), Vec3::new(0.0, s, c));
-        yaw * pitch
+        if self.frame != Mat3::IDENTITY {
+            r = self.frame * r;
+        }
+        r
+    }
+
+    /// Every value that decides the camera's rays, as bits: equal keys, equal rays.
+    pub fn key(&self) -> [u32; 15] {
+        let mut k = [0; 15];
+        k[..3].copy_from_slice(&self.position.to_array().map(f32::to_bits));
+        k[3] = self.yaw.to_bits();
+        k[4] = self.pitch.to_bits();
+        k[5..14].copy_from_slice(&self.frame.to_cols_array().map(f32::to_bits));
+        // No field of view is a NaN's bits: no angle has them.
+        k[14] = self.fov.unwrap_or(f32::NAN).to_bits();
+        k
+    }
+
+    /// The focal length in pixels for an image `width`×`height`.
+    pub fn focal(&self, width: u32, height: u32) -> f32 {
+        match self.fov {
+            None => width.min(height).max(1) as f32,
+            Some(fov) => height.max(1) as f32 * 0.5 / libm::tanf(fov * 0.5),
+        }
     }
 
     /// The camera's right axis in world space (+x at yaw 0).
@@ -68,13 +132,14 @@ impl Camera {
             rotation: self.rotation(),
             half_w: width as f32 * 0.5,
             half_h: height as f32 * 0.5,
-            focal: width.min(height).max(1) as f32,
+            focal: self.focal(width, height),
         }
     }
 }
 
-/// Generates primary rays for one frame: focal length = the shorter image side in pixels, so
-/// the box's front opening fits any aspect ratio (2·atan(½) ≈ 53.13° across the shorter side).
+/// Generates primary rays for one frame: by the seed's rule the focal length is the shorter
+/// image side in pixels, so the box's front opening fits any aspect ratio (2·atan(½) ≈ 53.13°
+/// across the shorter side); a camera with a field of view sets it from the image's height.
 #[derive(Clone, Copy, Debug)]
 pub struct RayGen {
     origin: Vec3,
@@ -385,6 +450,7 @@ mod tests {
                 position: Vec3::new(0.3 * i as f32, -0.2, -3.0 + i as f32),
                 yaw: 0.7 * i as f32 - 1.4,
                 pitch: 0.3 * i as f32 - 0.5,
+                ..Camera::default()
             };
             let g = cam.rays(w, h);
             let (w, h) = (w as usize, h as usize);
@@ -429,6 +495,42 @@ mod tests {
             shared > 100 && shared < tiles,
             "{shared} of {tiles} tiles share axes"
         );
+    }
+
+    /// `look_at` looks where it is told, keeps `up` up on screen, and its field of view spans
+    /// the image's height.
+    #[test]
+    fn look_at_points_the_camera() {
+        let mut rng = crate::rng::Rng::seeded(11);
+        let unit = |rng: &mut crate::rng::Rng| {
+            let v = Vec3::new(
+                (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32 - 0.5,
+                (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32 - 0.5,
+                (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32 - 0.5,
+            );
+            v * 10.0
+        };
+        for _ in 0..500 {
+            let (from, at, up) = (unit(&mut rng), unit(&mut rng), unit(&mut rng));
+            let Some(c) = Camera::look_at(from, at, up, Some(0.8)) else {
+                continue;
+            };
+            let d = (at - from).normalize();
+            assert!((c.forward() - d).length() < 1e-4, "{from} {at} {up}");
+            // The screen's up is on the side of `up`, and the right axis is level.
+            assert!(c.right().dot(up).abs() < 1e-3 * up.length());
+            assert!(-c.down().dot(up) >= -1e-4);
+            let r = c.rotation();
+            assert!((r.x_axis.cross(r.y_axis) - r.z_axis).length() < 1e-4);
+            let g = c.rays(200, 100);
+            let top = g.ray(100.0, 0.0).dir;
+            let bottom = g.ray(100.0, 100.0).dir;
+            assert!((top.angle_between(bottom) - 0.8).abs() < 1e-4);
+        }
+        assert_eq!(Camera::look_at(Vec3::ONE, Vec3::ONE, Vec3::Y, None), None);
+        // Straight down still gives a camera.
+        let c = Camera::look_at(Vec3::Y, Vec3::ZERO, Vec3::Y, None).unwrap();
+        assert!((c.forward() + Vec3::Y).length() < 1e-5);
     }
 
     #[test]

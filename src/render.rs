@@ -60,14 +60,10 @@ pub struct HitCache {
     hits: Vec<Option<Hit>>,
 }
 
-type CameraKey = ([u32; 3], u32, u32);
+type CameraKey = [u32; 15];
 
 fn camera_key(c: &Camera) -> CameraKey {
-    (
-        c.position.to_array().map(f32::to_bits),
-        c.yaw.to_bits(),
-        c.pitch.to_bits(),
-    )
+    c.key()
 }
 
 impl HitCache {

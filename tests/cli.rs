@@ -193,12 +193,12 @@ fn bad_values_get_a_clear_message_and_status_2() {
         ),
         (
             &["--scene", "/nonexistent/box.toml", "render"],
-            "--scene /nonexistent/box.toml: no such file: give the path of an existing .toml",
+            "--scene /nonexistent/box.toml: no such file: give the path of an existing model",
         ),
         (&["--scene", "/", "render"], "--scene /: is a folder"),
         (
-            &["--scene", "scenes/tetrahedron.obj", "render"],
-            "an OBJ mesh is not a scene: write a .toml scene with an [[object]] of kind = \"obj\" and path = \"tetrahedron.obj\"",
+            &["--scene", "/nonexistent/model.glb", "render"],
+            "--scene /nonexistent/model.glb: no such file: give the path of an existing model",
         ),
         (
             &["--scene", "Cornell", "render"],

@@ -481,3 +481,207 @@ fn long_run() {
         start.elapsed()
     );
 }
+
+// Model files: the same mutations over the small models in `tests/models/` (text formats as
+// text; binary ones byte by byte, with 32-bit counts and offsets overwritten by hostile
+// values). Every input must load into a scene that renders a finite frame, or be refused with
+// an error that names the file and says what is wrong; none may panic.
+
+mod models {
+    use super::*;
+    use raytty::scene::model::{self, Format, View};
+
+    /// The seed models: (name, format, bytes). The OBJ reads `cube.mtl` (mutated too).
+    fn seeds() -> Vec<(&'static str, Format, Vec<u8>)> {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/models");
+        [
+            "cube.obj",
+            "cube.ply",
+            "cube_binary.ply",
+            "cube.stl",
+            "cube_binary.stl",
+            "two_nodes.gltf",
+            "cube.glb",
+        ]
+        .into_iter()
+        .map(|n| {
+            let path = dir.join(n);
+            (n, Format::of(&path).unwrap(), std::fs::read(&path).unwrap())
+        })
+        .collect()
+    }
+
+    fn mtl() -> Vec<u8> {
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/models/cube.mtl")).unwrap()
+    }
+
+    /// 32-bit values that break counts, lengths and offsets.
+    const WORDS: [u32; 8] = [
+        0,
+        1,
+        3,
+        0x7fff_ffff,
+        0x8000_0000,
+        0xffff_ffff,
+        0xffff,
+        1 << 24,
+    ];
+
+    fn mutate_bytes(rng: &mut Rng, input: &[u8]) -> Vec<u8> {
+        let mut b = input.to_vec();
+        let pick = |rng: &mut Rng, n: usize| (rng.next_u64() % n.max(1) as u64) as usize;
+        for _ in 0..1 + pick(rng, 3) {
+            match pick(rng, 5) {
+                0 if !b.is_empty() => {
+                    let i = pick(rng, b.len());
+                    b[i] ^= 1 << pick(rng, 8);
+                }
+                1 if b.len() >= 4 => {
+                    let i = pick(rng, b.len() - 3) & !3;
+                    b[i..i + 4].copy_from_slice(&WORDS[pick(rng, WORDS.len())].to_le_bytes());
+                }
+                2 if !b.is_empty() => {
+                    let i = pick(rng, b.len());
+                    let n = 1 + pick(rng, 16);
+                    b.drain(i..(i + n).min(b.len()));
+                }
+                3 => b.truncate(pick(rng, b.len() + 1)),
+                _ => {
+                    let i = pick(rng, b.len() + 1);
+                    b.insert(i, pick(rng, 256) as u8);
+                }
+            }
+        }
+        b.truncate(MAX_INPUT);
+        b
+    }
+
+    /// Loads `bytes` as a model of `format` (its MTL `mtl`) and checks the outcome; panics on
+    /// a finding. Returns whether it loaded.
+    fn check(name: &str, format: Format, bytes: &[u8], mtl: &[u8]) -> bool {
+        let read = |p: &str| {
+            if p == "cube.mtl" {
+                Ok(("cube.mtl".to_string(), mtl.to_vec()))
+            } else {
+                Err(format!("cannot read {p}: no such file"))
+            }
+        };
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            let loaded = model::parse(format, bytes, name, &read)
+                .and_then(|m| m.into_scene(name, "fuzz", &View::default()));
+            if let Ok(l) = &loaded {
+                let s = &l.scene;
+                let settings = Stage::Indirect.settings(s.effects());
+                let frame = render(s, &s.camera(), s.lights(), &settings, 6, 4);
+                assert!(frame.image.pixels.iter().all(|p| p.is_finite()));
+            }
+            loaded
+        }));
+        let result = outcome.unwrap_or_else(|_| {
+            panic!(
+                "panic on {name}:\n{:?}\nmtl:\n{:?}",
+                String::from_utf8_lossy(bytes),
+                String::from_utf8_lossy(mtl)
+            )
+        });
+        match result {
+            Ok(_) => true,
+            Err(e) => {
+                assert!(!e.message.is_empty() && !e.file.is_empty(), "{e}");
+                let shown = e.to_string();
+                assert!(shown.starts_with(&e.file), "{shown}");
+                assert!(
+                    !shown.chars().any(|c| c.is_control() && c != '\n'),
+                    "{shown:?}"
+                );
+                false
+            }
+        }
+    }
+
+    pub(super) fn run(iterations: u64, seed: u64) -> (u64, u64) {
+        let seeds = seeds();
+        let mtl = mtl();
+        let mut rng = Rng::seeded(seed);
+        let (mut loaded, mut refused) = (0, 0);
+        for i in 0..iterations {
+            let (name, format, base) = &seeds[(i % seeds.len() as u64) as usize];
+            let text = !matches!(*name, "cube_binary.ply" | "cube_binary.stl" | "cube.glb");
+            let mutated = |rng: &mut Rng, b: &[u8]| {
+                if text && rng.next_u64().is_multiple_of(2) {
+                    super::mutate(rng, &String::from_utf8_lossy(b)).into_bytes()
+                } else {
+                    mutate_bytes(rng, b)
+                }
+            };
+            let (bytes, mtl) = match (format, rng.next_u64() % 4) {
+                (Format::Obj, 0) => (base.clone(), mutated(&mut rng, &mtl)),
+                _ => (mutated(&mut rng, base), mtl.clone()),
+            };
+            if check(name, *format, &bytes, &mtl) {
+                loaded += 1;
+            } else {
+                refused += 1;
+            }
+        }
+        (loaded, refused)
+    }
+
+    #[test]
+    fn every_seed_model_loads() {
+        for (name, format, bytes) in seeds() {
+            assert!(check(name, format, &bytes, &mtl()), "{name}");
+        }
+    }
+
+    /// `tests/fuzz_corpus/models/`: hostile model files, each refused (`ok_*` must load).
+    #[test]
+    fn model_corpus() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_corpus/models");
+        let mut n = 0;
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            let Some(format) = Format::of(&path) else {
+                continue;
+            };
+            n += 1;
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            let bytes = std::fs::read(&path).unwrap();
+            let loaded = check(&name, format, &bytes, &mtl());
+            assert_eq!(loaded, name.starts_with("ok_"), "{name}");
+        }
+        assert!(n >= 8, "the corpus has {n} model files");
+    }
+
+    /// A short run in every `cargo test`.
+    #[test]
+    fn short_model_run() {
+        let (loaded, refused) = run(700, 11);
+        assert!(
+            loaded > 0 && refused > 0,
+            "{loaded} loaded, {refused} refused"
+        );
+    }
+
+    /// The long run over models: `RAYTTY_FUZZ_ITERATIONS` inputs from `RAYTTY_FUZZ_SEED`.
+    #[test]
+    #[ignore]
+    fn long_model_run() {
+        let var = |name: &str, default: u64| {
+            std::env::var(name)
+                .ok()
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(default)
+        };
+        let (n, seed) = (
+            var("RAYTTY_FUZZ_ITERATIONS", 20_000),
+            var("RAYTTY_FUZZ_SEED", 1),
+        );
+        let start = Instant::now();
+        let (loaded, refused) = run(n, seed);
+        eprintln!(
+            "models: {n} inputs from seed {seed} in {:.1?}: {loaded} loaded, {refused} refused",
+            start.elapsed()
+        );
+    }
+}

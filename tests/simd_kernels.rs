@@ -430,6 +430,7 @@ fn tiles_of_rays_on_every_path_match_brute_force() {
                 position: cam.position + in_cube(&mut rng, 0.8),
                 yaw: uniform(&mut rng, -3.0, 3.0),
                 pitch: uniform(&mut rng, -1.0, 1.0),
+                ..Camera::default()
             }
             .rays(61, 45);
             let (x0, y0) = (

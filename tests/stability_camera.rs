@@ -15,6 +15,7 @@ fn cameras(short_block_centre: Vec3) -> Vec<(String, Camera)> {
         position,
         yaw,
         pitch,
+        ..Camera::default()
     };
     let mut list = vec![
         ("inside a block".into(), at(short_block_centre, 0.3, 0.0)),
@@ -101,6 +102,7 @@ fn a_camera_inside_a_closed_object_sees_only_its_inside() {
         position: centre,
         yaw: 0.3,
         pitch: 0.2,
+        ..Camera::default()
     };
     let settings = Stage::Flat.settings(scene.effects());
     let frame = render(&scene, &camera, scene.lights(), &settings, SIZE.0, SIZE.1);

@@ -62,6 +62,7 @@ fn random_poses_give_finite_in_range_images() {
             } else {
                 0.0
             },
+            ..Camera::default()
         };
         let light = PointLight {
             position: light_position(&mut rng, i),

@@ -28,6 +28,47 @@ pub struct Cli {
     /// (`raytty scenes` lists them). Default: the Cornell box.
     #[arg(long, global = true, value_name = "PATH|NAME")]
     pub(super) scene: Option<String>,
+    /// A model (.gltf, .glb, .obj, .ply, .stl) or scene file to open in the app, as
+    /// --scene FILE does.
+    #[arg(value_name = "FILE", conflicts_with = "scene")]
+    pub(super) file: Option<String>,
+    #[command(flatten)]
+    pub(super) view: ViewArgs,
+}
+
+/// Where the camera looks from, for the app and every command (over the scene's camera; a
+/// model file without one gets a camera framed on the model at a three-quarter view).
+#[derive(Args, Debug, Default)]
+pub(super) struct ViewArgs {
+    /// Camera position x,y,z.
+    #[arg(long, global = true, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(super) look_from: Option<Vec3>,
+    /// The point the camera looks at, x,y,z.
+    #[arg(long, global = true, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(super) look_at: Option<Vec3>,
+    /// Up on screen, x,y,z (model files: +y; the built-in scenes: their own, -y).
+    #[arg(long, global = true, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub(super) up: Option<Vec3>,
+    /// Vertical field of view in degrees, 1 to 170 (models: the file camera's, or 45; the
+    /// built-in scenes: 2·atan(1/2) ≈ 53.13 across the shorter side).
+    #[arg(long, global = true, value_name = "DEG")]
+    pub(super) fov: Option<f32>,
+    /// Which of a model file's cameras to look through, from 0 (default: the first, if any).
+    #[arg(long, global = true, value_name = "N")]
+    pub(super) camera_index: Option<usize>,
+}
+
+impl ViewArgs {
+    /// The library's view.
+    pub(super) fn view(&self) -> raytty::scene::model::View {
+        raytty::scene::model::View {
+            camera_index: self.camera_index,
+            look_from: self.look_from,
+            look_at: self.look_at,
+            up: self.up,
+            fov_degrees: self.fov,
+        }
+    }
 }
 
 /// The `--color` choices.

@@ -8,7 +8,11 @@ use super::{Failure, Result, usage};
 
 /// `raytty bench`: with no `--scene`, the accuracy price list of the Cornell box; with
 /// `--scene`, what that scene costs (load and acceleration build, frame times, M rays/s).
-pub(super) fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
+pub(super) fn run_bench(
+    a: BenchArgs,
+    scene: Option<&str>,
+    view: &raytty::scene::model::View,
+) -> Result<()> {
     if let Some(name) = scene {
         // The flags that shape the accuracy bench only conflict with --scene (args.rs).
         let sizes = match (a.sizes.is_empty(), a.quick) {
@@ -18,7 +22,7 @@ pub(super) fn run_bench(a: BenchArgs, scene: Option<&str>) -> Result<()> {
         };
         raytty::bench::check_sizes(&sizes).map_err(bench_failure)?;
         let start = std::time::Instant::now();
-        let scene = crate::cli::scene_arg::load_scene(Some(name))?;
+        let scene = crate::cli::scene_arg::load_scene(Some(name), view)?;
         let load = start.elapsed();
         let runs = a.runs.unwrap_or(if a.quick { 2 } else { 5 });
         let report = raytty::bench::scene::bench_scene(&scene, &sizes, runs);

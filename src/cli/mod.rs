@@ -39,13 +39,15 @@ pub fn main() -> u8 {
     let colorterm = std::env::var("COLORTERM").ok();
     let resolve = |c| resolve_color(c, dumb || no_color, colorterm.as_deref());
     let color = resolve(cli.color);
+    let view = cli.view.view();
+    let scene = cli.scene.as_deref().or(cli.file.as_deref());
     let result = match cli.command {
         Some(Command::Render(args)) => {
             let colors = RenderColor {
                 own: args.color.map(resolve),
                 inherited: color_given.map(resolve),
             };
-            run_render(&args, cli.scene.as_deref(), no_color, colors).map(|()| 0)
+            run_render(&args, scene, &view, no_color, colors).map(|()| 0)
         }
         Some(Command::Scenes) => stdout_is_open("the list").and_then(|()| {
             io::stdout()
@@ -54,9 +56,9 @@ pub fn main() -> u8 {
                 .map_err(Into::into)
         }),
         Some(Command::Bench(a)) => stdout_is_open("the table")
-            .and_then(|()| run_bench(a, cli.scene.as_deref()))
+            .and_then(|()| run_bench(a, scene, &view))
             .map(|()| 0),
-        None => run_default(color, cli.scene.as_deref(), dumb),
+        None => run_default(color, scene, &view, dumb),
     };
     match result {
         Ok(code) => code,
@@ -188,7 +190,12 @@ fn is_dumb(term: Option<&str>) -> bool {
 
 /// No command: the app on a terminal; otherwise (or on a dumb terminal) one frame to stdout,
 /// as `raytty render` with its defaults would print in `color`.
-fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<u8> {
+fn run_default(
+    color: ColorMode,
+    scene: Option<&str>,
+    view: &raytty::scene::model::View,
+    dumb: bool,
+) -> Result<u8> {
     #[cfg(feature = "tui")]
     if io::stdout().is_terminal() {
         if !dumb {
@@ -201,7 +208,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<u8> 
                     raytty::printable(scene.unwrap_or("the Cornell box"))
                 );
             }
-            let loaded = crate::cli::scene_arg::load_scene(scene);
+            let loaded = crate::cli::scene_arg::load_scene(scene, view);
             if note {
                 eprint!("\r\x1b[2K");
             }
@@ -228,6 +235,7 @@ fn run_default(color: ColorMode, scene: Option<&str>, dumb: bool) -> Result<u8> 
             simd: None,
         },
         scene,
+        view,
         false,
         RenderColor::default(),
     )?;

@@ -31,6 +31,7 @@ pub(super) struct RenderColor {
 pub(super) fn run_render(
     args: &RenderArgs,
     scene: Option<&str>,
+    view: &raytty::scene::model::View,
     no_color: bool,
     color: RenderColor,
 ) -> Result<()> {
@@ -83,7 +84,7 @@ pub(super) fn run_render(
             pixels * 48 / (1024 * 1024)
         );
     }
-    let mut scene = crate::cli::scene_arg::load_scene(scene)?;
+    let mut scene = crate::cli::scene_arg::load_scene(scene, view)?;
     if let Some(isa) = args.simd {
         let available: Vec<_> = raytty::simd::Isa::ALL
             .into_iter()
@@ -192,9 +193,20 @@ pub(super) fn run_render(
         .with_context(|| cannot_write(args))?;
     match args.stats {
         Some(StatsFormat::Text) => {
-            eprintln!("raytty: {w}x{h}, {}", stats.summary(scene.isa()))
+            let lights = if scene.lights_are_default() {
+                "; lights: default (the file has none)"
+            } else {
+                ""
+            };
+            eprintln!("raytty: {w}x{h}, {}{lights}", stats.summary(scene.isa()))
         }
-        Some(StatsFormat::Json) => eprintln!("{}", stats.to_json(scene.isa())),
+        Some(StatsFormat::Json) => {
+            let json = stats.to_json(scene.isa());
+            match (scene.lights_are_default(), json.strip_suffix('}')) {
+                (true, Some(open)) => eprintln!("{open},\"default_lights\":true}}"),
+                _ => eprintln!("{json}"),
+            }
+        }
         None => {}
     }
     Ok(())

@@ -1,16 +1,31 @@
-//! `--scene PATH|NAME`: a scene file if the path exists or ends in `.toml`, else a built-in
-//! scene's name. Every failure is a [`Failure::Usage`] (exit status 2) that says what would work.
+//! `--scene PATH|NAME` (or `raytty FILE`): a model file (`.gltf`, `.glb`, `.obj`, `.ply`,
+//! `.stl`), a scene file if the path exists or ends in `.toml`, else a built-in scene's name;
+//! then the view flags (`--look-from`, `--look-at`, `--up`, `--fov`, `--camera-index`) over its
+//! camera. Every failure is a [`Failure::Usage`] (exit status 2) that says what would work.
 
 use std::path::Path;
 
 use raytty::scene::builtin::{self, BUILTINS};
 use raytty::scene::file;
+use raytty::scene::model::{self, Format, View};
 use raytty::{Scene, printable};
 
 use crate::cli::{Failure, Result, usage};
 
-/// The scene `arg` names; the Cornell box when there is none.
-pub fn load_scene(arg: Option<&str>) -> Result<Scene> {
+/// The scene `arg` names (the Cornell box when there is none), seen through `view`. A model's
+/// notes (what the file has that is not drawn) go to stderr, one line each.
+pub fn load_scene(arg: Option<&str>, view: &View) -> Result<Scene> {
+    let scene = find_scene(arg, view)?;
+    if Format::of(Path::new(arg.unwrap_or_default())).is_some() {
+        return Ok(scene);
+    }
+    let camera = view
+        .apply(scene.camera())
+        .map_err(|e| Failure::Usage(e.to_string()))?;
+    Ok(scene.with_camera(camera))
+}
+
+fn find_scene(arg: Option<&str>, view: &View) -> Result<Scene> {
     let Some(arg) = arg else {
         return Ok(raytty::cornell_box());
     };
@@ -18,28 +33,24 @@ pub fn load_scene(arg: Option<&str>) -> Result<Scene> {
     let builtins = || builtin::names().join(", ");
     if path.is_dir() {
         usage!(
-            "--scene {}: is a folder: give the path of a .toml scene file (or a built-in scene: {})",
+            "--scene {}: is a folder: give the path of a model (.gltf, .glb, .obj, .ply, .stl) or a .toml scene file (or a built-in scene: {})",
             printable(arg),
             builtins()
         );
     }
-    if !path.exists() && arg.ends_with(".toml") {
+    if !path.exists() && (arg.ends_with(".toml") || Format::of(path).is_some()) {
         usage!(
-            "--scene {}: no such file: give the path of an existing .toml scene file (or a built-in scene: {})",
+            "--scene {}: no such file: give the path of an existing model (.gltf, .glb, .obj, .ply, .stl) or .toml scene file (or a built-in scene: {})",
             printable(arg),
             builtins()
         );
     }
-    if arg.to_ascii_lowercase().ends_with(".obj") {
-        usage!(
-            "--scene {}: an OBJ mesh is not a scene: write a .toml scene with an [[object]] of kind = \"obj\" and path = \"{}\" (scenes/example.toml shows one)",
-            printable(arg),
-            printable(
-                &path
-                    .file_name()
-                    .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
-            )
-        );
+    if Format::of(path).is_some() {
+        let loaded = model::load(path, view).map_err(|e| Failure::Usage(e.to_string()))?;
+        for note in &loaded.notes {
+            eprintln!("raytty: {}: {}", printable(arg), printable(note));
+        }
+        return Ok(loaded.scene);
     }
     if path.exists() {
         return file::load(path).map_err(|e| Failure::Usage(e.to_string()));
@@ -47,7 +58,7 @@ pub fn load_scene(arg: Option<&str>) -> Result<Scene> {
     match builtin::find(arg) {
         Some(b) => b.load().map_err(|e| Failure::Usage(e.to_string())),
         None => usage!(
-            "--scene {}: no such file and no built-in scene of that name{} (built-in scenes: {}; or give the path of a .toml scene file)",
+            "--scene {}: no such file and no built-in scene of that name{} (built-in scenes: {}; or give the path of a model or a .toml scene file)",
             printable(arg),
             file::did_you_mean(arg, &builtin::names()),
             builtins()

@@ -5,6 +5,7 @@
 pub mod builtin;
 pub mod cornell;
 pub mod file;
+pub mod model;
 pub mod obj;
 pub mod procedural;
 
@@ -110,6 +111,7 @@ pub struct Scene {
     /// The objects as added (ranges of `triangles`), for rebuilding the flat list.
     objects: Vec<Range<usize>>,
     has_mirrors: bool,
+    default_lights: bool,
 }
 
 /// Why a scene could not be built.
@@ -160,6 +162,8 @@ pub struct SceneBuilder {
     materials: Vec<Material>,
     lights: Vec<PointLight>,
     accel: Option<AccelKind>,
+    drop_degenerate: bool,
+    default_lights: bool,
 }
 
 /// Stands in for a degenerate triangle while validating; never part of a scene.
@@ -188,6 +192,25 @@ impl SceneBuilder {
         self.raw
             .extend(triangles.into_iter().map(|v| (v, material)));
         self.objects.push(start..self.raw.len());
+    }
+
+    /// Adds an object whose triangles each have their own material (a model's mesh).
+    pub fn mesh(&mut self, triangles: impl IntoIterator<Item = ([Vec3; 3], u32)>) {
+        let start = self.raw.len();
+        self.raw.extend(triangles);
+        self.objects.push(start..self.raw.len());
+    }
+
+    /// Degenerate triangles are dropped when the scene is built instead of failing it (models
+    /// made by other tools often have some); [`Scene::triangles`] then has fewer than added.
+    pub fn drop_degenerate(&mut self) {
+        self.drop_degenerate = true;
+    }
+
+    /// Marks the lights as the default rig put in for a model without any (said in the
+    /// status line and in `render --stats`).
+    pub fn default_lights(&mut self, yes: bool) {
+        self.default_lights = yes;
     }
 
     /// Adds a light.
@@ -224,7 +247,25 @@ impl SceneBuilder {
                 .map(validate)
                 .collect_into_vec(&mut triangles);
         }
-        if failed.into_inner() {
+        let mut objects = self.objects;
+        if failed.load(Ordering::Relaxed) && self.drop_degenerate {
+            // Keep the valid triangles in order, each object's range shrunk to its own.
+            let mut kept = Vec::with_capacity(triangles.len());
+            let mut ranges = Vec::with_capacity(objects.len());
+            for r in &objects {
+                let start = kept.len();
+                for i in r.clone() {
+                    let ([a, b, c], m) = self.raw[i];
+                    if Triangle::new(a, b, c, m).is_ok() {
+                        kept.push(triangles[i]);
+                    }
+                }
+                ranges.push(start..kept.len());
+            }
+            ranges.retain(|r| !r.is_empty());
+            triangles = kept;
+            objects = ranges;
+        } else if failed.into_inner() {
             let (index, problem) = self
                 .raw
                 .iter()
@@ -268,7 +309,8 @@ impl SceneBuilder {
         let kind = self
             .accel
             .unwrap_or_else(|| AccelKind::for_triangles(triangles.len()));
-        let accel = Accel::build_kind(&triangles, &self.objects, kind);
+        drop(self.raw);
+        let accel = Accel::build_kind(&triangles, &objects, kind);
         let has_mirrors = self.materials.iter().any(|m| m.mirror > 0.0);
         Ok(Scene {
             name: name.to_string(),
@@ -283,8 +325,9 @@ impl SceneBuilder {
                 1.0
             },
             accel,
-            objects: self.objects,
+            objects,
             has_mirrors,
+            default_lights: self.default_lights,
         })
     }
 }
@@ -317,9 +360,20 @@ impl Scene {
         &self.lights
     }
 
+    /// Whether the lights are the default rig, put in because the model's file has none.
+    pub fn lights_are_default(&self) -> bool {
+        self.default_lights
+    }
+
     /// The camera the scene starts with.
     pub fn camera(&self) -> Camera {
         self.camera
+    }
+
+    /// The same scene starting from another camera.
+    pub fn with_camera(mut self, camera: Camera) -> Scene {
+        self.camera = camera;
+        self
     }
 
     /// The effects the scene calls for.

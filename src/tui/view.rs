@@ -336,7 +336,11 @@ impl Screen {
             (true, true) => "N:denoised".to_string(),
             (true, false) => "N:raw".to_string(),
         };
-        let light = app.light().map_or_else(|| "none".into(), xyz);
+        let mut light = app.light().map_or_else(|| "none".into(), xyz);
+        if app.scene.lights_are_default() {
+            // The file has no light: these are the default rig's.
+            light += " (default)";
+        }
         // (text, rank): rank 0 is always shown, then the lowest ranks first while they fit.
         let mut fields = vec![
             (printable(app.scene.name()), 0),

@@ -1,0 +1,569 @@
+//! glTF 2.0, JSON (`.gltf`, buffers in files beside it or in `data:` URIs) and binary
+//! (`.glb`), through the `gltf` crate's parser and validator: the default scene's node
+//! hierarchy with its transforms, triangle meshes (lists, strips and fans; indexed or not) with
+//! their normals, first UVs and `COLOR_0`, metallic-roughness materials (with the emissive
+//! strength, IOR and transmission extensions), perspective cameras and `KHR_lights_punctual`
+//! point lights (spot lights as point lights; directional lights are not drawn yet, and said).
+//!
+//! Accessors are read here, each range checked against its buffer first, so no file can make
+//! a read go out of bounds. A required extension raytty does not read is an error naming it.
+//! Errors give the JSON path of what is wrong (`/meshes/0/primitives/1`), or a JSON line and
+//! column, or the GLB's byte layout.
+
+use ::gltf::accessor::{DataType, Dimensions};
+use ::gltf::mesh::Mode;
+use ::gltf::{Gltf, Node, buffer};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+
+use super::{FileReader, Model, ModelCamera, ModelLight, ModelMaterial, check_triangles};
+use crate::scene::file::SceneFileError;
+
+/// The extensions a file may require: those read here, and those whose absence only loses
+/// quality (`KHR_materials_volume`, `_specular`: parsed, for the materials to come).
+pub const KNOWN_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_transmission",
+    "KHR_materials_volume",
+    "KHR_materials_specular",
+];
+
+/// Deepest node hierarchy followed: deeper is taken for a cycle.
+const MAX_DEPTH: usize = 256;
+/// Most node instances visited (a node shared by many parents is visited once per parent).
+const MAX_NODE_VISITS: usize = 1_000_000;
+
+/// Reads `bytes` (a `.gltf` or `.glb`) as a model named `file`, its buffers through `read`.
+pub fn parse(bytes: &[u8], file: &str, read: FileReader) -> Result<Model, SceneFileError> {
+    let whole = |m: String| SceneFileError::whole_file(file, m);
+    let gltf = match Gltf::from_slice(bytes) {
+        Ok(g) => g,
+        Err(e) => return Err(parse_error(bytes, file, e)),
+    };
+    let mut buffers: Vec<Vec<u8>> = Vec::new();
+    for b in gltf.buffers() {
+        let at = format!("/buffers/{}", b.index());
+        let data = match b.source() {
+            buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| {
+                whole(format!(
+                    "{at}: refers to the GLB's binary chunk, which the file does not have"
+                ))
+            })?,
+            buffer::Source::Uri(uri) => {
+                uri_bytes(uri, read).map_err(|m| whole(format!("{at}: {m}")))?
+            }
+        };
+        if data.len() < b.length() {
+            return Err(whole(format!(
+                "{at}: byteLength is {} but the data has {} bytes",
+                b.length(),
+                data.len()
+            )));
+        }
+        buffers.push(data);
+    }
+    let mut model = Model::default();
+    // Material 0 is the default; glTF material i is i + 1.
+    model.materials.push(ModelMaterial::default());
+    for m in gltf.materials() {
+        model.materials.push(material(&m, &mut model.notes));
+    }
+    let roots: Vec<Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
+        Some(s) => s.nodes().collect(),
+        None => {
+            // No scene: every node that is no other's child is a root.
+            let mut child = vec![false; gltf.nodes().len()];
+            for n in gltf.nodes() {
+                for c in n.children() {
+                    child[c.index()] = true;
+                }
+            }
+            gltf.nodes().filter(|n| !child[n.index()]).collect()
+        }
+    };
+    let mut stack: Vec<(Node, Mat4, usize)> = roots
+        .into_iter()
+        .rev()
+        .map(|n| (n, Mat4::IDENTITY, 0))
+        .collect();
+    let mut visits = 0;
+    while let Some((node, parent, depth)) = stack.pop() {
+        let at = format!("/nodes/{}", node.index());
+        visits += 1;
+        if depth > MAX_DEPTH || visits > MAX_NODE_VISITS {
+            return Err(whole(format!(
+                "{at}: the node hierarchy is deeper than {MAX_DEPTH} or has more than {MAX_NODE_VISITS} node instances (a node that is its own ancestor?)"
+            )));
+        }
+        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+        let world = parent * local;
+        if !world.is_finite() {
+            return Err(whole(format!("{at}: its transform is not finite")));
+        }
+        if let Some(mesh) = node.mesh() {
+            for p in mesh.primitives() {
+                let at = format!("/meshes/{}/primitives/{}", mesh.index(), p.index());
+                primitive(&p, &world, &buffers, &mut model)
+                    .map_err(|m| whole(format!("{at}: {m}")))?;
+            }
+        }
+        if let Some(camera) = node.camera() {
+            match camera.projection() {
+                ::gltf::camera::Projection::Perspective(p) => model.cameras.push(ModelCamera {
+                    position: world.transform_point3(Vec3::ZERO),
+                    forward: world.transform_vector3(-Vec3::Z).normalize_or_zero(),
+                    up: world.transform_vector3(Vec3::Y).normalize_or_zero(),
+                    fov: Some(p.yfov()),
+                }),
+                ::gltf::camera::Projection::Orthographic(_) => model.note(format!(
+                    "camera {}: orthographic cameras are not used",
+                    camera.index()
+                )),
+            }
+        }
+        if let Some(light) = node.light() {
+            use ::gltf::khr_lights_punctual::Kind;
+            let intensity = Vec3::from(light.color()) * light.intensity();
+            let position = world.transform_point3(Vec3::ZERO);
+            match light.kind() {
+                Kind::Point => model.lights.push(ModelLight {
+                    position,
+                    intensity,
+                }),
+                Kind::Spot { .. } => {
+                    model.note(
+                        "spot lights are drawn as point lights (their cones are not used yet)",
+                    );
+                    model.lights.push(ModelLight {
+                        position,
+                        intensity,
+                    });
+                }
+                Kind::Directional => {
+                    model.note("directional lights are not drawn yet");
+                }
+            }
+        }
+        for c in node.children().collect::<Vec<_>>().into_iter().rev() {
+            stack.push((c, world, depth + 1));
+        }
+    }
+    if model
+        .lights
+        .iter()
+        .any(|l| !l.intensity.is_finite() || l.intensity.min_element() < 0.0)
+    {
+        return Err(whole(
+            "/extensions/KHR_lights_punctual/lights: a light's colour and intensity must be finite and non-negative".into(),
+        ));
+    }
+    if model
+        .cameras
+        .iter()
+        .any(|c| !c.position.is_finite() || c.forward == Vec3::ZERO)
+    {
+        return Err(whole(
+            "/cameras: a camera's node transform is degenerate".into(),
+        ));
+    }
+    Ok(model)
+}
+
+/// A `gltf` crate error as a positioned message.
+fn parse_error(bytes: &[u8], file: &str, e: ::gltf::Error) -> SceneFileError {
+    let glb = bytes.starts_with(b"glTF");
+    match e {
+        ::gltf::Error::Deserialize(j) if !glb => {
+            let text = String::from_utf8_lossy(bytes);
+            SceneFileError::at_line(
+                file,
+                &text,
+                j.line(),
+                j.column().max(1),
+                format!("JSON: {j}"),
+            )
+        }
+        ::gltf::Error::Deserialize(j) => {
+            SceneFileError::whole_file(file, format!("the GLB's JSON chunk: {j}"))
+        }
+        ::gltf::Error::Binary(b) => SceneFileError::whole_file(
+            file,
+            format!("not a readable GLB (12-byte header, then JSON and BIN chunks): {b}"),
+        ),
+        ::gltf::Error::Validation(list) => {
+            // A required extension first: it is why the rest cannot be read.
+            let required = Gltf::from_slice_without_validation(bytes)
+                .ok()
+                .and_then(|g| {
+                    g.extensions_required()
+                        .find(|x| !KNOWN_EXTENSIONS.contains(x))
+                        .map(str::to_string)
+                });
+            if let Some(x) = required {
+                return SceneFileError::whole_file(
+                    file,
+                    format!(
+                        "/extensionsRequired: the file requires extension `{x}`, which raytty does not read (it reads {})",
+                        KNOWN_EXTENSIONS.join(", ")
+                    ),
+                );
+            }
+            let shown: Vec<String> = list
+                .iter()
+                .take(3)
+                .map(|(path, err)| format!("{}: {err}", pointer(&path.to_string())))
+                .collect();
+            let more = match list.len() {
+                n if n > 3 => format!(" (and {} more)", n - 3),
+                _ => String::new(),
+            };
+            SceneFileError::whole_file(
+                file,
+                format!("not valid glTF 2.0: {}{more}", shown.join("; ")),
+            )
+        }
+        other => SceneFileError::whole_file(file, other.to_string()),
+    }
+}
+
+/// The `gltf` crate's path (`meshes[0].primitives[1].attributes["POSITION"]`) as a JSON
+/// pointer (`/meshes/0/primitives/1/attributes/POSITION`).
+fn pointer(path: &str) -> String {
+    let mut out = String::from("/");
+    for c in path.chars() {
+        match c {
+            '.' | '[' => {
+                if !out.ends_with('/') {
+                    out.push('/')
+                }
+            }
+            ']' | '"' => {}
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// A buffer's bytes: a `data:` URI's base64 payload, or a file beside the model.
+fn uri_bytes(uri: &str, read: FileReader) -> Result<Vec<u8>, String> {
+    use base64::Engine;
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let Some((_, payload)) = rest.split_once(";base64,") else {
+            return Err("a data URI must be base64 (`data:...;base64,...`)".into());
+        };
+        return base64::engine::general_purpose::STANDARD
+            .decode(payload)
+            .map_err(|e| format!("its data URI is not valid base64: {e}"));
+    }
+    read(&percent_decode(uri)).map(|(_, bytes)| bytes)
+}
+
+/// `%20` and the like in a relative URI, as the file name they stand for.
+fn percent_decode(uri: &str) -> String {
+    let b = uri.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%'
+            && let (Some(h), Some(l)) = (
+                b.get(i + 1).and_then(|&c| hex(c)),
+                b.get(i + 2).and_then(|&c| hex(c)),
+            )
+        {
+            out.push((h * 16 + l) as u8);
+            i += 3;
+            continue;
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+fn material(m: &::gltf::Material, notes: &mut Vec<String>) -> ModelMaterial {
+    let pbr = m.pbr_metallic_roughness();
+    let base = Vec4::from(pbr.base_color_factor());
+    let texture = pbr
+        .base_color_texture()
+        .map(|t| match t.texture().source().source() {
+            ::gltf::image::Source::Uri { uri, .. } => uri.to_string(),
+            ::gltf::image::Source::View { .. } => {
+                format!("image {} (embedded)", t.texture().source().index())
+            }
+        });
+    if let Some(t) = &texture {
+        let note = format!("texture {t}: not drawn yet (the base colour factor is)");
+        if !notes.contains(&note) {
+            notes.push(note);
+        }
+    }
+    let finite01 = |x: f32| {
+        if x.is_finite() {
+            x.clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    };
+    let emission = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
+    ModelMaterial {
+        name: m.name().unwrap_or_default().to_string(),
+        base_colour: base.truncate().to_array().map(finite01).into(),
+        metallic: finite01(pbr.metallic_factor()),
+        roughness: finite01(pbr.roughness_factor()),
+        emission: if emission.is_finite() {
+            emission.max(Vec3::ZERO)
+        } else {
+            Vec3::ZERO
+        },
+        ior: m
+            .ior()
+            .filter(|x| x.is_finite() && *x >= 1.0)
+            .unwrap_or(1.5),
+        transmission: m
+            .transmission()
+            .map_or(0.0, |t| finite01(t.transmission_factor())),
+        opacity: finite01(base.w),
+        base_colour_texture: texture,
+    }
+}
+
+/// Adds one primitive, transformed by `world`. An error says what is wrong, with the JSON path
+/// of the accessor at fault (the caller puts the primitive's path before it).
+fn primitive(
+    p: &::gltf::Primitive,
+    world: &Mat4,
+    buffers: &[Vec<u8>],
+    model: &mut Model,
+) -> Result<(), String> {
+    let mode = p.mode();
+    if !matches!(
+        mode,
+        Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+    ) {
+        model.note("points and lines are not drawn (only triangles)");
+        return Ok(());
+    }
+    let Some(positions) = p.get(&::gltf::Semantic::Positions) else {
+        return Err("attributes: no POSITION: a triangle primitive needs positions".into());
+    };
+    let positions = read_floats::<3>(&positions, buffers)?;
+    let first = model.positions.len();
+    let count = positions.len();
+    let normal_matrix = Mat3::from_mat4(*world).inverse().transpose();
+    model.positions.extend(
+        positions
+            .iter()
+            .map(|&v| world.transform_point3(Vec3::from(v))),
+    );
+    // Attributes some primitives have and others lack: zero normals and UVs, white colours.
+    if let Some(a) = p.get(&::gltf::Semantic::Normals) {
+        let n = read_floats::<3>(&a, buffers)?;
+        same_count(n.len(), count, "NORMAL")?;
+        model.normals.resize(first, Vec3::ZERO);
+        model.normals.extend(n.iter().map(|&v| {
+            let v = (normal_matrix * Vec3::from(v)).normalize_or_zero();
+            if v.is_finite() { v } else { Vec3::ZERO }
+        }));
+    }
+    if let Some(a) = p.get(&::gltf::Semantic::TexCoords(0)) {
+        let t = read_floats::<2>(&a, buffers)?;
+        same_count(t.len(), count, "TEXCOORD_0")?;
+        model.uvs.resize(first, Vec2::ZERO);
+        model.uvs.extend(t.iter().map(|&v| Vec2::from(v)));
+    }
+    if let Some(a) = p.get(&::gltf::Semantic::Colors(0)) {
+        let c: Vec<[f32; 4]> = match a.dimensions() {
+            Dimensions::Vec3 => read_floats::<3>(&a, buffers)?
+                .into_iter()
+                .map(|[r, g, b]| [r, g, b, 1.0])
+                .collect(),
+            _ => read_floats::<4>(&a, buffers)?,
+        };
+        same_count(c.len(), count, "COLOR_0")?;
+        model.colours.resize(first, Vec3::ONE);
+        model.colours.extend(
+            c.iter()
+                .map(|&[r, g, b, _]| Vec3::new(r, g, b).clamp(Vec3::ZERO, Vec3::ONE)),
+        );
+    }
+    for (list, fill) in [
+        (&mut model.normals, Vec3::ZERO),
+        (&mut model.colours, Vec3::ONE),
+    ] {
+        if !list.is_empty() {
+            list.resize(model.positions.len(), fill);
+        }
+    }
+    if !model.uvs.is_empty() {
+        model.uvs.resize(model.positions.len(), Vec2::ZERO);
+    }
+    let indices: Vec<u32> = match p.indices() {
+        Some(a) => {
+            let at = format!(" (accessor /accessors/{})", a.index());
+            let idx = read_indices(&a, buffers)?;
+            if let Some(bad) = idx.iter().find(|&&i| i as usize >= count) {
+                return Err(format!(
+                    "indices: index {bad} is out of range: the primitive has {count} vertices{at}"
+                ));
+            }
+            idx
+        }
+        None => (0..count as u32).collect(),
+    };
+    let n = indices.len();
+    let triangles = match mode {
+        Mode::Triangles => n / 3,
+        _ => n.saturating_sub(2),
+    };
+    check_triangles(model.triangles.len(), triangles)?;
+    let base = first as u32;
+    let material = p.material().index().map_or(0, |i| i as u32 + 1);
+    if material != 0 || !model.triangle_materials.is_empty() {
+        model.triangle_materials.resize(model.triangles.len(), 0);
+    }
+    for k in 0..triangles {
+        let t = match mode {
+            Mode::Triangles => [indices[3 * k], indices[3 * k + 1], indices[3 * k + 2]],
+            // Every other strip triangle is flipped so that all keep the strip's winding.
+            Mode::TriangleStrip if k % 2 == 1 => [indices[k + 1], indices[k], indices[k + 2]],
+            Mode::TriangleStrip => [indices[k], indices[k + 1], indices[k + 2]],
+            _ => [indices[0], indices[k + 1], indices[k + 2]],
+        };
+        model.triangles.push(t.map(|i| base + i));
+    }
+    if !model.triangle_materials.is_empty() {
+        model
+            .triangle_materials
+            .resize(model.triangles.len(), material);
+    }
+    Ok(())
+}
+
+fn same_count(n: usize, count: usize, what: &str) -> Result<(), String> {
+    if n != count {
+        return Err(format!(
+            "attribute {what}: {n} values for {count} positions: every attribute has one per vertex"
+        ));
+    }
+    Ok(())
+}
+
+/// The byte range of accessor `a`'s elements within its buffer, checked: (buffer, start,
+/// stride, element size). `None` for an accessor without a view (all zeros).
+fn layout(
+    a: &::gltf::Accessor,
+    buffers: &[Vec<u8>],
+) -> Result<Option<(usize, usize, usize, usize)>, String> {
+    let at = format!("/accessors/{}", a.index());
+    if a.sparse().is_some() {
+        return Err(format!("{at}: sparse accessors are not read yet"));
+    }
+    let Some(view) = a.view() else {
+        // No data: zeros, as many as the accessor says, which must be a sensible number.
+        if a.count() > 3 * super::MAX_MODEL_TRIANGLES {
+            return Err(format!(
+                "{at}: {} elements without data: too many",
+                a.count()
+            ));
+        }
+        return Ok(None);
+    };
+    let size = a.size();
+    let stride = view.stride().unwrap_or(size).max(size);
+    let start = view.offset().checked_add(a.offset());
+    let count = a.count();
+    let end = start.and_then(|s| {
+        count.checked_sub(1).map_or(Some(s), |last| {
+            last.checked_mul(stride)?.checked_add(s)?.checked_add(size)
+        })
+    });
+    let view_end = view.offset().checked_add(view.length());
+    let data = &buffers[view.buffer().index()];
+    match (start, end, view_end) {
+        (Some(s), Some(e), Some(ve)) if e <= ve && ve <= data.len() => {
+            Ok(Some((view.buffer().index(), s, stride, size)))
+        }
+        _ => Err(format!(
+            "{at}: {count} elements of {size} bytes every {stride}, from byte {} of buffer view {} (bytes {} to {} of buffer {}, which has {} bytes), do not fit",
+            a.offset(),
+            view.index(),
+            view.offset(),
+            view.offset().saturating_add(view.length()),
+            view.buffer().index(),
+            data.len()
+        )),
+    }
+}
+
+/// Accessor `a` as `N` floats an element (normalized integers scaled as glTF says).
+fn read_floats<const N: usize>(
+    a: &::gltf::Accessor,
+    buffers: &[Vec<u8>],
+) -> Result<Vec<[f32; N]>, String> {
+    let dims = match a.dimensions() {
+        Dimensions::Scalar => 1,
+        Dimensions::Vec2 => 2,
+        Dimensions::Vec3 => 3,
+        Dimensions::Vec4 => 4,
+        _ => 0,
+    };
+    if dims != N {
+        return Err(format!(
+            "/accessors/{}: has {dims} components an element where {N} are expected",
+            a.index()
+        ));
+    }
+    let Some((buffer, start, stride, _)) = layout(a, buffers)? else {
+        return Ok(vec![[0.0; N]; a.count()]);
+    };
+    let data = &buffers[buffer];
+    let ty = a.data_type();
+    let norm = a.normalized();
+    let comp = ty.size();
+    let value = |o: usize| -> f32 {
+        let b = &data[o..o + comp];
+        match ty {
+            DataType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            DataType::U8 if norm => b[0] as f32 / 255.0,
+            DataType::U8 => b[0] as f32,
+            DataType::I8 if norm => (b[0] as i8 as f32 / 127.0).max(-1.0),
+            DataType::I8 => b[0] as i8 as f32,
+            DataType::U16 if norm => u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0,
+            DataType::U16 => u16::from_le_bytes([b[0], b[1]]) as f32,
+            DataType::I16 if norm => (i16::from_le_bytes([b[0], b[1]]) as f32 / 32767.0).max(-1.0),
+            DataType::I16 => i16::from_le_bytes([b[0], b[1]]) as f32,
+            DataType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f32,
+        }
+    };
+    Ok((0..a.count())
+        .map(|i| std::array::from_fn(|k| value(start + i * stride + k * comp)))
+        .collect())
+}
+
+/// Index accessor `a` (unsigned bytes, shorts or ints).
+fn read_indices(a: &::gltf::Accessor, buffers: &[Vec<u8>]) -> Result<Vec<u32>, String> {
+    if a.dimensions() != Dimensions::Scalar
+        || !matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
+    {
+        return Err(format!(
+            "/accessors/{}: indices must be scalars of unsigned bytes, shorts or ints",
+            a.index()
+        ));
+    }
+    let Some((buffer, start, stride, size)) = layout(a, buffers)? else {
+        return Ok(vec![0; a.count()]);
+    };
+    let data = &buffers[buffer];
+    Ok((0..a.count())
+        .map(|i| {
+            let b = &data[start + i * stride..start + i * stride + size];
+            match size {
+                1 => b[0] as u32,
+                2 => u16::from_le_bytes([b[0], b[1]]) as u32,
+                _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            }
+        })
+        .collect())
+}

@@ -1,0 +1,415 @@
+//! Models made by other tools: glTF 2.0 (`.gltf`, `.glb`), OBJ with MTL, PLY and STL. Each
+//! format's reader fills one [`Model`] (positions, optional normals, UVs and vertex colours,
+//! triangles with their materials, the file's cameras and lights); [`Model::into_scene`] turns
+//! it into a [`Scene`] with a camera that finds the model ([`view`]) and, when the file has no
+//! light, the default rig.
+//!
+//! Materials keep every physically based value the file gives (metallic, roughness, emission,
+//! index of refraction, transmission, opacity, the base colour texture's name) for the
+//! physically based materials to come; today's [`Material`] takes the base colour only
+//! (times the triangle's average vertex colour).
+//!
+//! Every mistake is a [`SceneFileError`] naming the file and where: a line and column in text,
+//! a JSON path in glTF, a byte offset in binary data.
+
+pub mod gltf;
+pub mod mtl;
+pub mod obj;
+pub mod ply;
+pub mod stl;
+pub mod view;
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+
+use crate::scene::file::SceneFileError;
+use crate::scene::{Effects, MAX_COORDINATE, Material, PointLight, Scene, SceneBuilder};
+
+pub use view::{View, ViewError};
+
+/// Most triangles a model file may have: some 200 bytes a triangle while it loads and its BVH
+/// is built, so 30 million need about 6 GB.
+pub const MAX_MODEL_TRIANGLES: usize = 30_000_000;
+/// Largest model file read (with the files it names: MTL, glTF buffers): a binary PLY of
+/// 30 million triangles is about 0.6 GB, an OBJ of as many some 1.5 GB.
+pub const MAX_MODEL_BYTES: u64 = 2 << 30;
+/// Most lights taken from a file (as [`crate::scene::file::MAX_LIGHTS`] for scene files).
+pub const MAX_MODEL_LIGHTS: usize = crate::scene::file::MAX_LIGHTS;
+
+/// The file formats raytty reads models from, by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// glTF 2.0, JSON (`.gltf`) or binary (`.glb`).
+    Gltf,
+    /// Wavefront OBJ, with its MTL material libraries.
+    Obj,
+    /// PLY (Stanford), ASCII or binary.
+    Ply,
+    /// STL, ASCII or binary.
+    Stl,
+}
+
+impl Format {
+    /// The format of a file named `path`, by its extension (any case).
+    pub fn of(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match ext.as_str() {
+            "gltf" | "glb" => Format::Gltf,
+            "obj" => Format::Obj,
+            "ply" => Format::Ply,
+            "stl" => Format::Stl,
+            _ => return None,
+        })
+    }
+}
+
+/// A material as a file describes it. Colours are linear RGB.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelMaterial {
+    /// The file's name for it ("" if none).
+    pub name: String,
+    /// Base colour (diffuse albedo for dielectrics), linear RGB.
+    pub base_colour: Vec3,
+    /// Metalness in [0, 1].
+    pub metallic: f32,
+    /// Perceptual roughness in [0, 1].
+    pub roughness: f32,
+    /// Emitted radiance, linear RGB (glTF's emissive factor times its strength; MTL's `Ke`).
+    pub emission: Vec3,
+    /// Index of refraction.
+    pub ior: f32,
+    /// Fraction of light transmitted through the surface, [0, 1].
+    pub transmission: f32,
+    /// Opacity (glTF's base colour alpha, MTL's `d`), [0, 1].
+    pub opacity: f32,
+    /// The base colour texture's file or URI, if any (not sampled yet).
+    pub base_colour_texture: Option<String>,
+}
+
+impl Default for ModelMaterial {
+    /// A light grey dielectric: what a triangle without a material gets.
+    fn default() -> ModelMaterial {
+        ModelMaterial {
+            name: String::new(),
+            base_colour: Vec3::splat(0.8),
+            metallic: 0.0,
+            roughness: 1.0,
+            emission: Vec3::ZERO,
+            ior: 1.5,
+            transmission: 0.0,
+            opacity: 1.0,
+            base_colour_texture: None,
+        }
+    }
+}
+
+/// A camera a file places.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelCamera {
+    /// Eye position.
+    pub position: Vec3,
+    /// Unit view direction.
+    pub forward: Vec3,
+    /// Unit up direction on screen.
+    pub up: Vec3,
+    /// Vertical field of view in radians, if the file gives one.
+    pub fov: Option<f32>,
+}
+
+/// A light a file places.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelLight {
+    /// Where it is.
+    pub position: Vec3,
+    /// Radiant intensity per channel (W/sr; glTF's colour times intensity).
+    pub intensity: Vec3,
+}
+
+/// A triangle mesh read from a file, before it becomes a [`Scene`].
+#[derive(Clone, Debug, Default)]
+pub struct Model {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Vertex normals: empty, or one per position.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates: empty, or one per position.
+    pub uvs: Vec<Vec2>,
+    /// Vertex colours, linear RGB: empty, or one per position.
+    pub colours: Vec<Vec3>,
+    /// Triangles as indices into `positions`.
+    pub triangles: Vec<[u32; 3]>,
+    /// Each triangle's index into `materials`; empty when every triangle has material 0.
+    pub triangle_materials: Vec<u32>,
+    /// Materials (at least one once the model is read).
+    pub materials: Vec<ModelMaterial>,
+    /// The file's cameras, in its order.
+    pub cameras: Vec<ModelCamera>,
+    /// The file's point lights.
+    pub lights: Vec<ModelLight>,
+    /// What the file has that raytty read but does not use, one line each (for the user).
+    pub notes: Vec<String>,
+}
+
+/// A loaded model scene and what the user should know about it.
+#[derive(Debug)]
+pub struct Loaded {
+    /// The scene.
+    pub scene: Scene,
+    /// What the file has that is not used, and what was dropped (degenerate triangles).
+    pub notes: Vec<String>,
+}
+
+impl Model {
+    /// The material of triangle `i`.
+    pub fn material_of(&self, i: usize) -> u32 {
+        self.triangle_materials.get(i).copied().unwrap_or(0)
+    }
+
+    /// Adds a note (kept once: the same note twice is said once).
+    pub fn note(&mut self, note: impl Into<String>) {
+        let note = note.into();
+        if !self.notes.contains(&note) {
+            self.notes.push(note);
+        }
+    }
+
+    /// The model as a scene named `name`, seen through `view` (the file's camera, or one
+    /// framed on the model), with the file's lights or else the default rig. Degenerate
+    /// triangles (zero area), which exporters leave in, are dropped and counted in a note.
+    pub fn into_scene(
+        mut self,
+        file: &str,
+        name: &str,
+        view: &View,
+    ) -> Result<Loaded, SceneFileError> {
+        if self.materials.is_empty() {
+            self.materials.push(ModelMaterial::default());
+        }
+        if self.triangles.is_empty() {
+            return Err(SceneFileError::whole_file(
+                file,
+                "the file has no triangles: raytty shows triangle meshes (points and lines are not drawn)",
+            ));
+        }
+        if let Some(p) = self
+            .positions
+            .iter()
+            .find(|p| !p.is_finite() || p.abs().max_element() > MAX_COORDINATE)
+        {
+            return Err(SceneFileError::whole_file(
+                file,
+                format!(
+                    "a vertex at {p} (after the file's transforms) is out of range: coordinates must be finite and within ±{MAX_COORDINATE:e}"
+                ),
+            ));
+        }
+        let bounds = self.bounds();
+        let camera = view
+            .camera(&self.cameras, bounds)
+            .map_err(|e| SceneFileError::whole_file(file, e.to_string()))?;
+        let mut b = SceneBuilder::new();
+        b.drop_degenerate();
+        let materials = self.scene_materials(&mut b);
+        let positions = &self.positions;
+        b.mesh(self.triangles.iter().enumerate().map(|(i, t)| {
+            (
+                t.map(|v| positions[v as usize]),
+                materials[i.min(materials.len() - 1)],
+            )
+        }));
+        let mut lights: Vec<PointLight> = self
+            .lights
+            .iter()
+            .take(MAX_MODEL_LIGHTS)
+            .map(|l| PointLight {
+                position: l.position,
+                // A point light of radiant intensity I emits 4π·I.
+                power: l.intensity * (4.0 * std::f32::consts::PI),
+            })
+            .collect();
+        if self.lights.len() > MAX_MODEL_LIGHTS {
+            self.note(format!(
+                "{} lights: the first {MAX_MODEL_LIGHTS} are used",
+                self.lights.len()
+            ));
+        }
+        let default_lights = lights.is_empty();
+        if default_lights {
+            lights = view::default_rig(&camera, bounds);
+        }
+        for l in lights {
+            b.light(l);
+        }
+        b.default_lights(default_lights);
+        let mut notes = self.notes;
+        let triangles = self.triangles.len();
+        drop(self.positions);
+        drop(self.triangles);
+        let scene = b
+            .build(name, camera, Effects::default())
+            .map_err(|e| SceneFileError::whole_file(file, e.to_string()))?;
+        let dropped = triangles - scene.triangles().len();
+        if scene.triangles().is_empty() {
+            return Err(SceneFileError::whole_file(
+                file,
+                format!("all {triangles} triangles have zero area: nothing to show"),
+            ));
+        }
+        if dropped > 0 {
+            notes.push(format!(
+                "{dropped} of {triangles} triangles have zero area and were dropped"
+            ));
+        }
+        Ok(Loaded { scene, notes })
+    }
+
+    /// The box around the positions the triangles use (min, max).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for p in &self.positions {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        (lo, hi)
+    }
+
+    /// Today's materials for the triangles, one index per triangle (or one for all): the
+    /// base colour, times the triangle's average vertex colour when the model has them
+    /// (rounded to 8 bits a channel so that a scan's colours share materials).
+    fn scene_materials(&self, b: &mut SceneBuilder) -> Vec<u32> {
+        let colour = |m: &ModelMaterial| m.base_colour.clamp(Vec3::ZERO, Vec3::ONE);
+        if self.colours.is_empty() {
+            let ids: Vec<u32> = self
+                .materials
+                .iter()
+                .map(|m| b.material(Material::diffuse(colour(m))))
+                .collect();
+            if self.triangle_materials.is_empty() {
+                return vec![ids[0]];
+            }
+            return self
+                .triangle_materials
+                .iter()
+                .map(|&m| ids[(m as usize).min(ids.len() - 1)])
+                .collect();
+        }
+        let mut ids: HashMap<(u32, [u8; 3]), u32> = HashMap::new();
+        self.triangles
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let m = (self.material_of(i) as usize).min(self.materials.len() - 1);
+                let c = t.iter().map(|&v| self.colours[v as usize]).sum::<Vec3>() / 3.0;
+                let q = (c.clamp(Vec3::ZERO, Vec3::ONE) * 255.0)
+                    .round()
+                    .to_array()
+                    .map(|x| x as u8);
+                *ids.entry((m as u32, q)).or_insert_with(|| {
+                    let c = Vec3::from(q.map(|x| x as f32 / 255.0));
+                    b.material(Material::diffuse(colour(&self.materials[m]) * c))
+                })
+            })
+            .collect()
+    }
+}
+
+/// Reads the model file at `path` (its format by extension) with the files it names, and
+/// builds its scene seen through `view`. The scene is named by the file's stem.
+pub fn load(path: &Path, view: &View) -> Result<Loaded, SceneFileError> {
+    let shown = path.display().to_string();
+    let Some(format) = Format::of(path) else {
+        return Err(SceneFileError::whole_file(
+            &shown,
+            "not a model file raytty reads: give a .gltf, .glb, .obj, .ply or .stl file",
+        ));
+    };
+    let bytes = read_capped(path).map_err(|e| SceneFileError::whole_file(&shown, e))?;
+    let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    let read = move |name: &str| {
+        let full = base.join(name);
+        read_capped(&full).map(|b| (full.display().to_string(), b))
+    };
+    let model = parse(format, &bytes, &shown, &read)?;
+    drop(bytes);
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| shown.clone());
+    model.into_scene(&shown, &stem, view)
+}
+
+/// Reads a file a model names (an MTL library, a glTF buffer): given its name as written,
+/// the name to show and its bytes, or why it cannot be read.
+pub type FileReader<'a> = &'a dyn Fn(&str) -> Result<(String, Vec<u8>), String>;
+
+/// Parses `bytes` as a model of `format`; `file` names it in messages and `read` reads the
+/// files it names. The pure core the fuzzer drives.
+pub fn parse(
+    format: Format,
+    bytes: &[u8],
+    file: &str,
+    read: FileReader,
+) -> Result<Model, SceneFileError> {
+    let model = match format {
+        Format::Gltf => gltf::parse(bytes, file, read)?,
+        Format::Obj => obj::parse(bytes, file, read)?,
+        Format::Ply => ply::parse(bytes, file)?,
+        Format::Stl => stl::parse(bytes, file)?,
+    };
+    debug_assert!(
+        model
+            .triangles
+            .iter()
+            .flatten()
+            .all(|&v| (v as usize) < model.positions.len())
+    );
+    Ok(model)
+}
+
+/// A [`FileReader`] for models read from memory: every named file is missing.
+pub fn no_files(name: &str) -> Result<(String, Vec<u8>), String> {
+    Err(format!(
+        "{name}: not read (the model was given without its folder)"
+    ))
+}
+
+/// Reads at most [`MAX_MODEL_BYTES`] of `path`; the error says which file and why.
+fn read_capped(path: &Path) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    let unreadable = |e: std::io::Error| format!("{} cannot be read: {e}", path.display());
+    let file = std::fs::File::open(path).map_err(unreadable)?;
+    let mut bytes = Vec::new();
+    file.take(MAX_MODEL_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(unreadable)?;
+    if bytes.len() as u64 > MAX_MODEL_BYTES {
+        return Err(format!(
+            "{} is larger than {} GiB, the limit for model files",
+            path.display(),
+            MAX_MODEL_BYTES >> 30
+        ));
+    }
+    Ok(bytes)
+}
+
+/// The linear value of an sRGB-encoded channel in [0, 1].
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Checks that a model may add `more` triangles to `have`; the message names the cap.
+pub(crate) fn check_triangles(have: usize, more: usize) -> Result<(), String> {
+    if have.saturating_add(more) > MAX_MODEL_TRIANGLES {
+        return Err(format!(
+            "the model has more than {MAX_MODEL_TRIANGLES} triangles, the limit for model files"
+        ));
+    }
+    Ok(())
+}

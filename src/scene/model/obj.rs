@@ -1,0 +1,51 @@
+//! OBJ models: the OBJ reader's indexed mesh ([`crate::scene::obj::parse_obj_model`]) with the
+//! materials of the MTL libraries it names. A library that cannot be read is a note (the model
+//! shows in the default material), as is a `usemtl` name no library defines; a mistake inside
+//! a library is an error at its line and column.
+
+use super::{FileReader, MAX_MODEL_TRIANGLES, Model, ModelMaterial, mtl};
+use crate::scene::file::SceneFileError;
+use crate::scene::obj::{ObjError, line_text, parse_obj_model};
+
+/// Reads `bytes` as an OBJ model named `file`, its libraries through `read`.
+pub fn parse(bytes: &[u8], file: &str, read: FileReader) -> Result<Model, SceneFileError> {
+    let positioned = |name: &str, bytes: &[u8], e: ObjError| {
+        SceneFileError::on_line(name, &line_text(bytes, e.line), e.line, e.column, e.message)
+    };
+    let obj = parse_obj_model(bytes, MAX_MODEL_TRIANGLES, 3 * MAX_MODEL_TRIANGLES)
+        .map_err(|e| positioned(file, bytes, e))?;
+    let mut model = Model {
+        positions: obj.positions,
+        normals: obj.normals,
+        uvs: obj.uvs,
+        triangles: obj.triangles,
+        triangle_materials: obj.triangle_materials,
+        ..Model::default()
+    };
+    let mut library: Vec<ModelMaterial> = Vec::new();
+    for (name, _line, _column) in &obj.libraries {
+        match read(name) {
+            Ok((shown, bytes)) => {
+                library.extend(mtl::parse_mtl(&bytes).map_err(|e| positioned(&shown, &bytes, e))?)
+            }
+            Err(e) => model.note(format!("material library: {e}; default materials used")),
+        }
+    }
+    for name in &obj.material_names {
+        let found = library.iter().rev().find(|m| &m.name == name);
+        if found.is_none() && !name.is_empty() && !obj.libraries.is_empty() {
+            model.note(format!(
+                "material `{name}` is in no library: default material used"
+            ));
+        }
+        let m = found.cloned().unwrap_or_else(|| ModelMaterial {
+            name: name.clone(),
+            ..ModelMaterial::default()
+        });
+        if let Some(t) = &m.base_colour_texture {
+            model.note(format!("texture {t}: not drawn yet (the base colour is)"));
+        }
+        model.materials.push(m);
+    }
+    Ok(model)
+}

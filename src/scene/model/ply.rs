@@ -1,0 +1,671 @@
+//! PLY (the Stanford polygon format), ASCII and binary of either byte order: the `vertex`
+//! element's positions, normals (`nx ny nz`), texture coordinates (`u v`, `s t` or
+//! `texture_u texture_v`) and colours (`red green blue`, integer types scaled to [0, 1], taken
+//! as sRGB), and the `face` element's index lists, fanned into triangles. Other elements and
+//! properties are read past.
+//!
+//! Why not a crate: `ply-rs-bw` (the maintained fork of `ply-rs`) reads each element into a
+//! map from property names to values, a few hundred bytes a vertex and an allocation each,
+//! where a 10-million-triangle scan must stay near a hundred bytes a triangle; and its errors
+//! give no line or byte offset. The format fits in this file.
+//!
+//! Errors name the header's line and column, an ASCII body's line and column, or a binary
+//! body's byte offset, with the element and property being read. Counts in the header are
+//! checked against the file's size before anything is allocated.
+
+use glam::{Vec2, Vec3};
+
+use super::{Model, check_triangles, srgb_to_linear};
+use crate::scene::file::SceneFileError;
+
+/// A property's scalar type.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn parse(name: &[u8]) -> Option<Scalar> {
+        Some(match name {
+            b"char" | b"int8" => Scalar::I8,
+            b"uchar" | b"uint8" => Scalar::U8,
+            b"short" | b"int16" => Scalar::I16,
+            b"ushort" | b"uint16" => Scalar::U16,
+            b"int" | b"int32" => Scalar::I32,
+            b"uint" | b"uint32" => Scalar::U32,
+            b"float" | b"float32" => Scalar::F32,
+            b"double" | b"float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::F64 => 8,
+        }
+    }
+
+    /// The largest value of an integer type (colours are scaled by it), 1 for floats.
+    fn unit(self) -> f64 {
+        match self {
+            Scalar::I8 => 127.0,
+            Scalar::U8 => 255.0,
+            Scalar::I16 => 32767.0,
+            Scalar::U16 => 65535.0,
+            Scalar::I32 => 2147483647.0,
+            Scalar::U32 => 4294967295.0,
+            Scalar::F32 | Scalar::F64 => 1.0,
+        }
+    }
+
+    fn is_integer(self) -> bool {
+        !matches!(self, Scalar::F32 | Scalar::F64)
+    }
+}
+
+/// What a vertex property feeds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Role {
+    Position(usize),
+    Normal(usize),
+    Uv(usize),
+    Colour(usize),
+    FaceIndices,
+    Other,
+}
+
+#[derive(Clone, Debug)]
+struct Property {
+    name: String,
+    /// `Some(count type)` for a list.
+    list: Option<Scalar>,
+    scalar: Scalar,
+    role: Role,
+}
+
+#[derive(Clone, Debug)]
+struct Element {
+    name: String,
+    count: usize,
+    properties: Vec<Property>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Encoding {
+    Ascii,
+    Little,
+    Big,
+}
+
+/// Reads `bytes` as a PLY model named `file`.
+pub fn parse(bytes: &[u8], file: &str) -> Result<Model, SceneFileError> {
+    let (encoding, elements, body) = header(bytes, file)?;
+    let mut model = Model::default();
+    let mut reader = Body {
+        bytes,
+        at: body,
+        encoding,
+        file,
+        line: 0,
+        line_start: body,
+    };
+    if encoding == Encoding::Ascii {
+        reader.line = bytes[..body].iter().filter(|&&b| b == b'\n').count() + 1;
+    }
+    let mut vertices_read = None;
+    for e in &elements {
+        let min_size = e.properties.iter().map(|p| match p.list {
+            Some(c) => c.size(),
+            None => p.scalar.size(),
+        });
+        let min_size = match encoding {
+            // At least one character and a separator a value.
+            Encoding::Ascii => 2 * e.properties.len(),
+            _ => min_size.sum(),
+        };
+        if e.count.saturating_mul(min_size.max(1)) > bytes.len() - reader.at.min(bytes.len()) {
+            return Err(SceneFileError::whole_file(
+                file,
+                format!(
+                    "the header says {} {} elements, more than the file's {} bytes can hold: the file is cut short or its header is wrong",
+                    e.count,
+                    e.name,
+                    bytes.len()
+                ),
+            ));
+        }
+        match e.name.as_str() {
+            "vertex" => {
+                vertex_element(&mut reader, e, &mut model)?;
+                vertices_read = Some(e.count);
+            }
+            "face" => {
+                let Some(count) = vertices_read else {
+                    return Err(SceneFileError::whole_file(
+                        file,
+                        "the face element comes before the vertex element: raytty reads vertices first",
+                    ));
+                };
+                face_element(&mut reader, e, count, &mut model)?;
+            }
+            _ => {
+                if e.count > 0 {
+                    model.note(format!("PLY element `{}` is not read", e.name));
+                }
+                for i in 0..e.count {
+                    for p in &e.properties {
+                        reader.skip(p, &e.name, i)?;
+                    }
+                    reader.end_record()?;
+                }
+            }
+        }
+    }
+    Ok(model)
+}
+
+fn vertex_element(r: &mut Body, e: &Element, model: &mut Model) -> Result<(), SceneFileError> {
+    let has = |role: fn(usize) -> Role| e.properties.iter().any(|p| p.role == role(0));
+    for axis in 0..3 {
+        if !e.properties.iter().any(|p| p.role == Role::Position(axis)) {
+            return Err(SceneFileError::whole_file(
+                r.file,
+                format!(
+                    "the vertex element has no `{}` property: a vertex needs x, y and z",
+                    ["x", "y", "z"][axis]
+                ),
+            ));
+        }
+    }
+    let (normals, uvs, colours) = (has(Role::Normal), has(Role::Uv), has(Role::Colour));
+    model.positions.reserve_exact(e.count);
+    if normals {
+        model.normals.reserve_exact(e.count);
+    }
+    if uvs {
+        model.uvs.reserve_exact(e.count);
+    }
+    if colours {
+        model.colours.reserve_exact(e.count);
+    }
+    for i in 0..e.count {
+        let (mut p, mut n, mut t, mut c) = ([0.0f32; 3], [0.0f32; 3], [0.0f32; 2], [1.0f32; 3]);
+        for prop in &e.properties {
+            if prop.list.is_some() {
+                r.skip(prop, "vertex", i)?;
+                continue;
+            }
+            let at = r.value_start();
+            let v = r.scalar(prop.scalar, "vertex", i, &prop.name)?;
+            match prop.role {
+                Role::Position(k) => {
+                    if !(v.is_finite() && v.abs() <= crate::scene::MAX_COORDINATE as f64) {
+                        return Err(r.error(
+                            at,
+                            format!(
+                                "vertex {i}: {} = {v} is out of range: expected a finite number within ±{:e}",
+                                prop.name,
+                                crate::scene::MAX_COORDINATE
+                            ),
+                        ));
+                    }
+                    p[k] = v as f32
+                }
+                Role::Normal(k) => n[k] = v as f32,
+                Role::Uv(k) => t[k] = v as f32,
+                Role::Colour(k) => c[k] = (v / prop.scalar.unit()) as f32,
+                _ => {}
+            }
+        }
+        r.end_record()?;
+        model.positions.push(Vec3::from(p));
+        if normals {
+            let n = Vec3::from(n);
+            model.normals.push(if n.is_finite() {
+                n.normalize_or_zero()
+            } else {
+                Vec3::ZERO
+            });
+        }
+        if uvs {
+            model.uvs.push(Vec2::from(t));
+        }
+        if colours {
+            let c = Vec3::from(c.map(|x| {
+                if x.is_finite() {
+                    srgb_to_linear(x.clamp(0.0, 1.0))
+                } else {
+                    0.0
+                }
+            }));
+            model.colours.push(c);
+        }
+    }
+    Ok(())
+}
+
+fn face_element(
+    r: &mut Body,
+    e: &Element,
+    vertices: usize,
+    model: &mut Model,
+) -> Result<(), SceneFileError> {
+    if !e.properties.iter().any(|p| p.role == Role::FaceIndices) {
+        return Err(SceneFileError::whole_file(
+            r.file,
+            "the face element has no `vertex_indices` list",
+        ));
+    }
+    model.triangles.reserve(e.count);
+    let mut face: Vec<u32> = Vec::new();
+    for i in 0..e.count {
+        for prop in &e.properties {
+            let (Role::FaceIndices, Some(count_type)) = (prop.role, prop.list) else {
+                r.skip(prop, "face", i)?;
+                continue;
+            };
+            let at = r.value_start();
+            let n = r.count(count_type, "face", i)?;
+            if n < 3 {
+                return Err(r.error(
+                    at,
+                    format!("face {i} has {n} vertices: a face needs at least 3"),
+                ));
+            }
+            face.clear();
+            for _ in 0..n {
+                let at = r.value_start();
+                let v = r.scalar(prop.scalar, "face", i, &prop.name)?;
+                if !(v >= 0.0 && v < vertices as f64 && v.fract() == 0.0) {
+                    return Err(r.error(
+                        at,
+                        format!(
+                            "face {i}: vertex index {v} is out of range: the file has {vertices} vertices (indices 0 to {})",
+                            vertices.saturating_sub(1)
+                        ),
+                    ));
+                }
+                face.push(v as u32);
+            }
+            check_triangles(model.triangles.len(), face.len() - 2).map_err(|m| r.error(at, m))?;
+            for k in 1..face.len() - 1 {
+                model.triangles.push([face[0], face[k], face[k + 1]]);
+            }
+        }
+        r.end_record()?;
+    }
+    Ok(())
+}
+
+/// Reads the header: the encoding, the elements, and where the body starts.
+fn header(bytes: &[u8], file: &str) -> Result<(Encoding, Vec<Element>, usize), SceneFileError> {
+    let mut at = 0;
+    let mut encoding = None;
+    let mut elements: Vec<Element> = Vec::new();
+    let mut line = 0;
+    loop {
+        line += 1;
+        let Some(len) = bytes[at..].iter().position(|&b| b == b'\n') else {
+            return Err(SceneFileError::whole_file(
+                file,
+                "the header has no `end_header` line: is this a PLY file?",
+            ));
+        };
+        let raw = &bytes[at..at + len];
+        let text = String::from_utf8_lossy(raw);
+        at += len + 1;
+        let err = |message: String| SceneFileError::on_line(file, &text, line, 1, message);
+        let words: Vec<&[u8]> = raw
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|w| !w.is_empty())
+            .collect();
+        if line == 1 {
+            if words != [b"ply"] {
+                return Err(err("a PLY file starts with a line `ply`".into()));
+            }
+            continue;
+        }
+        match words.first().copied() {
+            None | Some(b"comment") | Some(b"obj_info") => {}
+            Some(b"format") => {
+                encoding = Some(match words.get(1).copied() {
+                    Some(b"ascii") => Encoding::Ascii,
+                    Some(b"binary_little_endian") => Encoding::Little,
+                    Some(b"binary_big_endian") => Encoding::Big,
+                    _ => {
+                        return Err(err(
+                            "expected `format ascii 1.0`, `format binary_little_endian 1.0` or `format binary_big_endian 1.0`".into(),
+                        ));
+                    }
+                });
+            }
+            Some(b"element") => {
+                let (Some(name), Some(count)) = (words.get(1), words.get(2)) else {
+                    return Err(err("expected `element NAME COUNT`".into()));
+                };
+                let count = std::str::from_utf8(count)
+                    .ok()
+                    .and_then(|c| c.parse::<usize>().ok())
+                    .ok_or_else(|| err("the element's count is not a whole number".into()))?;
+                elements.push(Element {
+                    name: String::from_utf8_lossy(name).into_owned(),
+                    count,
+                    properties: Vec::new(),
+                });
+            }
+            Some(b"property") => {
+                let Some(element) = elements.last_mut() else {
+                    return Err(err("a property before any `element` line".into()));
+                };
+                let bad_type = || {
+                    err("unknown property type: expected char, uchar, short, ushort, int, uint, float, double (or int8 ... float64)".into())
+                };
+                let (list, scalar, name) = if words.get(1) == Some(&&b"list"[..]) {
+                    let (Some(c), Some(t), Some(n)) = (words.get(2), words.get(3), words.get(4))
+                    else {
+                        return Err(err("expected `property list COUNT_TYPE TYPE NAME`".into()));
+                    };
+                    let c = Scalar::parse(c).ok_or_else(bad_type)?;
+                    if !c.is_integer() {
+                        return Err(err("a list's count type must be an integer type".into()));
+                    }
+                    (Some(c), Scalar::parse(t).ok_or_else(bad_type)?, n)
+                } else {
+                    let (Some(t), Some(n)) = (words.get(1), words.get(2)) else {
+                        return Err(err("expected `property TYPE NAME`".into()));
+                    };
+                    (None, Scalar::parse(t).ok_or_else(bad_type)?, n)
+                };
+                let name = String::from_utf8_lossy(name).into_owned();
+                let role = match (element.name.as_str(), list.is_some(), name.as_str()) {
+                    ("vertex", false, "x") => Role::Position(0),
+                    ("vertex", false, "y") => Role::Position(1),
+                    ("vertex", false, "z") => Role::Position(2),
+                    ("vertex", false, "nx") => Role::Normal(0),
+                    ("vertex", false, "ny") => Role::Normal(1),
+                    ("vertex", false, "nz") => Role::Normal(2),
+                    ("vertex", false, "u" | "s" | "texture_u" | "texture_s") => Role::Uv(0),
+                    ("vertex", false, "v" | "t" | "texture_v" | "texture_t") => Role::Uv(1),
+                    ("vertex", false, "red" | "r" | "diffuse_red") => Role::Colour(0),
+                    ("vertex", false, "green" | "g" | "diffuse_green") => Role::Colour(1),
+                    ("vertex", false, "blue" | "b" | "diffuse_blue") => Role::Colour(2),
+                    ("face", true, "vertex_indices" | "vertex_index") => Role::FaceIndices,
+                    _ => Role::Other,
+                };
+                if role != Role::Other && element.properties.iter().any(|p| p.role == role) {
+                    return Err(err(format!("property `{name}` is given twice")));
+                }
+                if role == Role::FaceIndices && !scalar.is_integer() {
+                    return Err(err("face indices must be of an integer type".into()));
+                }
+                element.properties.push(Property {
+                    name,
+                    list,
+                    scalar,
+                    role,
+                });
+            }
+            Some(b"end_header") => break,
+            Some(w) => {
+                return Err(err(format!(
+                    "unknown header line `{}`: expected format, element, property, comment or end_header",
+                    String::from_utf8_lossy(w)
+                )));
+            }
+        }
+    }
+    let Some(encoding) = encoding else {
+        return Err(SceneFileError::whole_file(
+            file,
+            "the header has no `format` line",
+        ));
+    };
+    Ok((encoding, elements, at))
+}
+
+/// A cursor over the body: binary values at a byte offset, or ASCII values one record a line.
+struct Body<'a> {
+    bytes: &'a [u8],
+    at: usize,
+    encoding: Encoding,
+    file: &'a str,
+    /// ASCII: the 1-based line of `at` and where that line starts.
+    line: usize,
+    line_start: usize,
+}
+
+impl Body<'_> {
+    /// An error at byte `at`: its line and column in an ASCII body, its offset in a binary one.
+    fn error(&self, at: usize, message: String) -> SceneFileError {
+        if self.encoding == Encoding::Ascii {
+            let end = self.bytes[self.line_start..]
+                .iter()
+                .position(|&b| b == b'\n')
+                .map_or(self.bytes.len(), |e| self.line_start + e);
+            let text = String::from_utf8_lossy(&self.bytes[self.line_start..end]);
+            let before = &self.bytes[self.line_start..at.clamp(self.line_start, end)];
+            let column = String::from_utf8_lossy(before).chars().count() + 1;
+            SceneFileError::on_line(self.file, &text, self.line, column, message)
+        } else {
+            SceneFileError::whole_file(self.file, format!("byte {at}: {message}"))
+        }
+    }
+
+    /// Where the next value starts (past the spaces before it in ASCII), for its errors.
+    fn value_start(&mut self) -> usize {
+        if self.encoding == Encoding::Ascii {
+            while self.at < self.bytes.len() && matches!(self.bytes[self.at], b' ' | b'\t' | b'\r')
+            {
+                self.at += 1;
+            }
+        }
+        self.at
+    }
+
+    /// The next ASCII token on the current record's line.
+    fn token(&mut self, what: &str) -> Result<std::ops::Range<usize>, SceneFileError> {
+        while self.at < self.bytes.len() && matches!(self.bytes[self.at], b' ' | b'\t' | b'\r') {
+            self.at += 1;
+        }
+        let start = self.at;
+        while self.at < self.bytes.len() && !self.bytes[self.at].is_ascii_whitespace() {
+            self.at += 1;
+        }
+        if start == self.at {
+            return Err(self.error(start, format!("{what}: the line ends early")));
+        }
+        Ok(start..self.at)
+    }
+
+    /// Moves past the end of an ASCII record's line (nothing but spaces may be left on it).
+    fn end_record(&mut self) -> Result<(), SceneFileError> {
+        if self.encoding != Encoding::Ascii {
+            return Ok(());
+        }
+        while self.at < self.bytes.len() && matches!(self.bytes[self.at], b' ' | b'\t' | b'\r') {
+            self.at += 1;
+        }
+        match self.bytes.get(self.at) {
+            Some(b'\n') => {
+                self.at += 1;
+                self.line += 1;
+                self.line_start = self.at;
+                Ok(())
+            }
+            None => Ok(()),
+            Some(_) => Err(self.error(
+                self.at,
+                "more values on the line than the header's properties".into(),
+            )),
+        }
+    }
+
+    fn scalar(
+        &mut self,
+        s: Scalar,
+        element: &str,
+        i: usize,
+        property: &str,
+    ) -> Result<f64, SceneFileError> {
+        let what = || format!("{element} {i}, property {property}");
+        if self.encoding == Encoding::Ascii {
+            let at = self.value_start();
+            let range = self.token(&what())?;
+            let tok = &self.bytes[range];
+            let v = std::str::from_utf8(tok).ok().and_then(|t| {
+                if s.is_integer() {
+                    t.parse::<i64>().ok().map(|v| v as f64)
+                } else {
+                    t.parse::<f64>().ok()
+                }
+            });
+            let v = v.ok_or_else(|| {
+                let t = String::from_utf8_lossy(tok).into_owned();
+                self.error(at, format!("{}: `{t}` is not a number of its type", what()))
+            })?;
+            return Ok(v);
+        }
+        let size = s.size();
+        let Some(raw) = self.bytes.get(self.at..self.at + size) else {
+            return Err(self.error(self.at, format!("{}: the file ends early", what())));
+        };
+        self.at += size;
+        let mut b = [0u8; 8];
+        b[..size].copy_from_slice(raw);
+        if self.encoding == Encoding::Big {
+            b[..size].reverse();
+        }
+        Ok(match s {
+            Scalar::I8 => b[0] as i8 as f64,
+            Scalar::U8 => b[0] as f64,
+            Scalar::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
+            Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
+            Scalar::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            Scalar::F64 => f64::from_le_bytes(b),
+        })
+    }
+
+    /// A list's length.
+    fn count(&mut self, s: Scalar, element: &str, i: usize) -> Result<usize, SceneFileError> {
+        let at = self.at;
+        let n = self.scalar(s, element, i, "list length")?;
+        if !(n >= 0.0 && n.fract() == 0.0) {
+            return Err(self.error(at, format!("{element} {i}: list length {n} is not a count")));
+        }
+        // Every entry takes at least a byte: a longer list cannot fit in the file.
+        if n as usize > self.bytes.len() - self.at.min(self.bytes.len()) {
+            return Err(self.error(
+                at,
+                format!("{element} {i}: list length {n} is longer than the rest of the file"),
+            ));
+        }
+        Ok(n as usize)
+    }
+
+    /// Reads past one property.
+    fn skip(&mut self, p: &Property, element: &str, i: usize) -> Result<(), SceneFileError> {
+        let n = match p.list {
+            Some(c) => self.count(c, element, i)?,
+            None => 1,
+        };
+        for _ in 0..n {
+            self.scalar(p.scalar, element, i, &p.name)?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ASCII: &str = "ply\nformat ascii 1.0\ncomment a quad\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 255 0 0\n1 0 0 255 0 0\n1 1 0 255 0 0\n0 1 0 255 0 0\n4 0 1 2 3\n";
+
+    #[test]
+    fn ascii_quads_are_fanned_and_colours_kept() {
+        let m = parse(ASCII.as_bytes(), "q.ply").unwrap();
+        assert_eq!(m.positions.len(), 4);
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(m.colours[2], Vec3::new(1.0, 0.0, 0.0));
+    }
+
+    /// The same quad in both binary byte orders reads as the ASCII one.
+    #[test]
+    fn binary_of_both_orders_reads_the_same() {
+        for big in [false, true] {
+            let head = ASCII.split("end_header\n").next().unwrap().replace(
+                "format ascii",
+                if big {
+                    "format binary_big_endian"
+                } else {
+                    "format binary_little_endian"
+                },
+            ) + "end_header\n";
+            let mut b = head.into_bytes();
+            for (x, y) in [(0.0f32, 0.0f32), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+                for v in [x, y, 0.0] {
+                    b.extend(if big {
+                        v.to_be_bytes()
+                    } else {
+                        v.to_le_bytes()
+                    });
+                }
+                b.extend([255, 0, 0]);
+            }
+            b.push(4);
+            for i in 0..4i32 {
+                b.extend(if big {
+                    i.to_be_bytes()
+                } else {
+                    i.to_le_bytes()
+                });
+            }
+            let m = parse(&b, "q.ply").unwrap();
+            assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+            assert_eq!(m.positions[2], Vec3::new(1.0, 1.0, 0.0));
+            // Cut short: the byte offset of the missing value.
+            let e = parse(&b[..b.len() - 2], "q.ply").unwrap_err();
+            assert!(
+                e.message.starts_with(&format!("byte {}", b.len() - 4)),
+                "{e}"
+            );
+        }
+    }
+
+    #[test]
+    fn mistakes_are_positioned() {
+        let e = parse(ASCII.replace("4 0 1 2 3", "4 0 1 2 7").as_bytes(), "q.ply").unwrap_err();
+        assert_eq!((e.line, e.column), (18, 9), "{e}");
+        assert!(e.message.contains("out of range"), "{e}");
+        let e = parse(
+            ASCII
+                .replace("property uchar blue", "property colour blue")
+                .as_bytes(),
+            "q.ply",
+        )
+        .unwrap_err();
+        assert_eq!(e.line, 10, "{e}");
+        let e = parse(
+            ASCII.replace("vertex 4", "vertex 4000000").as_bytes(),
+            "q.ply",
+        )
+        .unwrap_err();
+        assert!(e.message.contains("cut short"), "{e}");
+        let e = parse(b"ply\nformat ascii 1.0\n", "q.ply").unwrap_err();
+        assert!(e.message.contains("end_header"), "{e}");
+        let e = parse(ASCII.replace("1 1 0 255", "1 x 0 255").as_bytes(), "q.ply").unwrap_err();
+        assert_eq!((e.line, e.column), (16, 3), "{e}");
+    }
+}

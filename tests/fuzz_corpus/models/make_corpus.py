@@ -1,0 +1,46 @@
+#!/usr/bin/env python3
+"""Writes the hostile model files of this corpus (run from this folder). Every file must be
+refused with a clear error, but those named ok_*, which must load."""
+import copy, json, struct
+
+def w(name, data):
+    with open(name, "wb") as f:
+        f.write(data if isinstance(data, bytes) else data.encode())
+
+w("huge_count.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n")
+w("list_length_huge.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n" + struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack("<I", 0xffffffff))
+w("index_out_of_range.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n")
+w("count_mismatch.stl", b"x" * 80 + struct.pack("<I", 0x7fffffff) + b"\0" * 50)
+w("unclosed_loop.stl", "solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n")
+w("bad_texture_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n")
+w("nan_normal_ref.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn nan 0 1\nf 1//1 2//1 3//1\n")
+w("only_degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n")
+w("ok_degenerate_among_good.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n")
+
+base = {"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]}
+
+def g(name, change):
+    d = copy.deepcopy(base)
+    change(d)
+    w(name, json.dumps(d))
+
+def exponential(d):
+    # Each node has the next one as its child twice: 2^40 instances without a cycle.
+    d["nodes"] = [{"children": [i + 1, i + 1]} for i in range(40)] + [{"mesh": 0}]
+
+g("ok_triangle.gltf", lambda d: None)
+g("required_extension.gltf", lambda d: d.update({"extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"]}))
+g("accessor_past_buffer.gltf", lambda d: d["accessors"][0].update({"count": 1000}))
+g("view_past_buffer.gltf", lambda d: d["bufferViews"][0].update({"byteOffset": 30}))
+g("cyclic_nodes.gltf", lambda d: d["nodes"][0].update({"children": [0]}))
+g("missing_buffer_file.gltf", lambda d: d["buffers"][0].update({"uri": "nowhere.bin"}))
+g("bad_base64.gltf", lambda d: d["buffers"][0].update({"uri": "data:application/octet-stream;base64,@@@"}))
+g("huge_count_no_view.gltf", lambda d: (d["accessors"][0].pop("bufferView"), d["accessors"][0].update({"count": 4000000000})))
+g("exponential_instances.gltf", exponential)
+w("not_json.gltf", "{\"asset\": {\"version\": \"2.0\"},\n  \"nodes\": [ oops ]\n}")
+w("bad_glb_length.glb", b"glTF" + struct.pack("<II", 2, 0xffffff) + struct.pack("<II", 0xfffff0, 0x4E4F534A) + b"{}  ")
