@@ -112,6 +112,7 @@ pub struct Scene {
     objects: Vec<Range<usize>>,
     has_mirrors: bool,
     default_lights: bool,
+    step: f32,
 }
 
 /// Why a scene could not be built.
@@ -164,6 +165,7 @@ pub struct SceneBuilder {
     accel: Option<AccelKind>,
     drop_degenerate: bool,
     default_lights: bool,
+    step: Option<f32>,
 }
 
 /// Stands in for a degenerate triangle while validating; never part of a scene.
@@ -211,6 +213,12 @@ impl SceneBuilder {
     /// status line and in `render --stats`).
     pub fn default_lights(&mut self, yes: bool) {
         self.default_lights = yes;
+    }
+
+    /// How far the app's keys move the camera and light, as a multiple of the Cornell box's
+    /// steps (default 1).
+    pub fn step(&mut self, scale: f32) {
+        self.step = Some(scale);
     }
 
     /// Adds a light.
@@ -328,6 +336,10 @@ impl SceneBuilder {
             objects,
             has_mirrors,
             default_lights: self.default_lights,
+            step: self
+                .step
+                .filter(|s| s.is_finite() && *s > 0.0)
+                .unwrap_or(1.0),
         })
     }
 }
@@ -358,6 +370,12 @@ impl Scene {
     /// The lights the scene starts with (finite positions, non-negative power).
     pub fn lights(&self) -> &[PointLight] {
         &self.lights
+    }
+
+    /// How far the app's keys move the camera and light, as a multiple of the Cornell box's
+    /// steps: 1 for the built-in scenes and scene files, a model's size over the box's.
+    pub fn step(&self) -> f32 {
+        self.step
     }
 
     /// Whether the lights are the default rig, put in because the model's file has none.

@@ -11,6 +11,12 @@ pub enum Message {
     Walk(f32),
     /// Turn the camera by this many radians (positive: to the right).
     Turn(f32),
+    /// Tilt the camera by this many radians (positive: down), within ±[`MAX_PITCH_DEGREES`].
+    Pitch(f32),
+    /// Multiply the field of view by this factor (below 1: zoom in).
+    Zoom(f32),
+    /// Put the camera back where the scene starts it (the model framed again), lights kept.
+    Frame,
     /// Move the light by this offset in camera axes (right, down, forward), scene units.
     MoveLight(Vec3),
     /// Switch to a stage.
@@ -35,6 +41,9 @@ pub enum Message {
     /// Give the terminal back to the shell until it resumes us (Ctrl-Z; `fg` resumes).
     Suspend,
 }
+
+/// The steepest the camera looks up or down, in degrees.
+pub const MAX_PITCH_DEGREES: f32 = 89.0;
 
 /// The app's state.
 #[derive(Clone, Debug)]
@@ -95,8 +104,34 @@ impl App {
 pub fn update(app: &mut App, msg: Message) {
     let image_changes = match msg {
         Message::Walk(d) => {
-            app.camera.position += app.camera.forward() * d;
+            // Steps are the Cornell box's, scaled to the scene's size (1 for the box: exact).
+            app.camera.position += app.camera.forward() * (d * app.scene.step());
             d != 0.0
+        }
+        Message::Pitch(a) => {
+            let max = MAX_PITCH_DEGREES.to_radians();
+            let pitch = (app.camera.pitch + a).clamp(-max, max);
+            let changed = pitch != app.camera.pitch;
+            app.camera.pitch = pitch;
+            changed
+        }
+        Message::Zoom(f) => {
+            let (lo, hi) = raytty::camera::FOV_RANGE_DEGREES;
+            // A camera on the seed's rule starts from the field of view it has across the
+            // image's height.
+            let (w, h) = (app.size.0.max(1) as f32, 2.0 * app.size.1.max(1) as f32);
+            let now = app
+                .camera
+                .fov
+                .unwrap_or_else(|| 2.0 * (0.5 * h / w.min(h)).atan());
+            let fov = (now * f).clamp(lo.to_radians(), hi.to_radians());
+            let changed = Some(fov) != app.camera.fov;
+            app.camera.fov = Some(fov);
+            changed
+        }
+        Message::Frame => {
+            app.camera = app.scene.camera();
+            true
         }
         Message::Turn(a) => {
             // Keep yaw in (−π, π] so the status line stays readable after many turns.
@@ -107,7 +142,7 @@ pub fn update(app: &mut App, msg: Message) {
             changed
         }
         Message::MoveLight(local) => {
-            let world = app.camera.to_world(local);
+            let world = app.camera.to_world(local * app.scene.step());
             match app.lights.first_mut() {
                 Some(l) => {
                     l.position += world;
@@ -184,6 +219,21 @@ mod tests {
         update(&mut a, Message::Walk(0.1));
         assert!((a.camera.position - start - Vec3::new(0.1, 0.0, 0.1)).length() < TOLERANCE);
         assert_eq!(a.generation, 3);
+    }
+
+    #[test]
+    fn pitch_zoom_and_frame_again() {
+        let mut a = app();
+        update(&mut a, Message::Pitch(2.0));
+        assert_eq!(a.camera.pitch, MAX_PITCH_DEGREES.to_radians());
+        update(&mut a, Message::Zoom(0.5));
+        let fov = a.camera.fov.unwrap();
+        // 80x24 cells are 80x48 pixels: the seed's rule spans 2·atan(½) across the height.
+        assert!((fov - 0.5f32.atan()).abs() < TOLERANCE, "{fov}");
+        let g = a.generation;
+        update(&mut a, Message::Frame);
+        assert_eq!(a.camera, a.scene.camera());
+        assert_eq!(a.generation, g + 1);
     }
 
     #[test]

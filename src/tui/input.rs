@@ -190,7 +190,13 @@ fn parse_csi(b: &[u8]) -> Parsed {
             mods |= flag;
         }
     }
-    Parsed::Key(j + 1, arrow(f).map(|c| KeyEvent::new(c, mods)))
+    // `CSI 5 ~` and `CSI 6 ~`: Page Up and Page Down.
+    let code = match (f, params.split(';').next()) {
+        (b'~', Some("5")) => Some(KeyCode::PageUp),
+        (b'~', Some("6")) => Some(KeyCode::PageDown),
+        _ => arrow(f),
+    };
+    Parsed::Key(j + 1, code.map(|c| KeyEvent::new(c, mods)))
 }
 
 fn arrow(f: u8) -> Option<KeyCode> {

@@ -13,6 +13,8 @@ pub const WALK_STEP: f32 = 0.1;
 pub const TURN_STEP_DEGREES: f32 = 5.0;
 /// One press of W/A/S/D/Q/E moves the light this far (scene units).
 pub const LIGHT_STEP: f32 = 0.1;
+/// One press of - widens the field of view by this factor; + narrows it by as much.
+pub const ZOOM_STEP: f32 = 1.15;
 /// With Shift, every step is this fraction of the normal one.
 pub const FINE: f32 = 0.2;
 
@@ -20,6 +22,9 @@ pub const FINE: f32 = 0.2;
 pub const KEYS: &[(&str, &str)] = &[
     ("Up / Down", "move forward / back (Shift: finer)"),
     ("Left / Right", "turn left / right (Shift: finer)"),
+    ("PgUp / PgDn", "look up / down (Shift: finer)"),
+    ("+ / -", "zoom in / out"),
+    ("F", "frame the model again (the starting view)"),
     ("W / S", "light forward / back (Shift: finer)"),
     ("A / D", "light left / right (Shift: finer)"),
     ("Q / E", "light up / down (Shift: finer)"),
@@ -63,6 +68,8 @@ pub fn message_for(key: KeyEvent) -> Option<Message> {
         KeyCode::Down => Some(Message::Walk(-walk)),
         KeyCode::Left => Some(Message::Turn(-turn)),
         KeyCode::Right => Some(Message::Turn(turn)),
+        KeyCode::PageUp => Some(Message::Pitch(-turn)),
+        KeyCode::PageDown => Some(Message::Pitch(turn)),
         KeyCode::Char(c) => {
             let step = LIGHT_STEP * fine(c.is_ascii_uppercase() || shift);
             let light =
@@ -76,6 +83,9 @@ pub fn message_for(key: KeyEvent) -> Option<Message> {
                 'q' => light(0.0, -1.0, 0.0),
                 'e' => light(0.0, 1.0, 0.0),
                 'r' => Some(Message::Reset),
+                'f' => Some(Message::Frame),
+                '+' | '=' => Some(Message::Zoom(1.0 / ZOOM_STEP)),
+                '-' | '_' => Some(Message::Zoom(ZOOM_STEP)),
                 'n' => Some(Message::ToggleDenoise),
                 'c' => Some(Message::CycleColor),
                 'h' | '?' => Some(Message::ToggleHelp),

@@ -243,6 +243,8 @@ impl Model {
             b.light(l);
         }
         b.default_lights(default_lights);
+        // The Cornell box's diagonal is 2·√3: the keys' steps are the box's, scaled.
+        b.step((bounds.1 - bounds.0).length() / (2.0 * 3f32.sqrt()));
         let mut notes = self.notes;
         let triangles = self.triangles.len();
         drop(self.positions);
