@@ -10,6 +10,85 @@ use glam::Vec3;
 /// buffers), so 64 Mpixel stays near 3 GiB.
 pub const MAX_PIXELS: u64 = 64 * 1024 * 1024;
 
+/// How an image's linear radiance becomes what a screen shows (PNG and the terminal; PFM stays
+/// linear).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ToneMap {
+    /// Clamped to [0, 1], no transfer function: the seed's look, kept by its scenes.
+    #[default]
+    Linear,
+    /// Khronos PBR Neutral (the published reference curve), then the sRGB transfer: models.
+    Neutral,
+}
+
+impl ToneMap {
+    /// Every tone map, for the command line.
+    pub const ALL: [ToneMap; 2] = [ToneMap::Linear, ToneMap::Neutral];
+
+    /// The name the command line uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneMap::Linear => "none",
+            ToneMap::Neutral => "neutral",
+        }
+    }
+
+    /// The display value of linear radiance `c`, in [0, 1] per channel (NaN: 0).
+    pub fn apply(self, c: Vec3) -> Vec3 {
+        match self {
+            ToneMap::Linear => c,
+            ToneMap::Neutral => {
+                let c = Vec3::from(
+                    c.to_array()
+                        .map(|x| if x.is_nan() { 0.0 } else { x.max(0.0) }),
+                );
+                pbr_neutral(c).to_array().map(srgb_encode).into()
+            }
+        }
+    }
+
+    /// `image` as a screen should show it: itself for [`ToneMap::Linear`] (not copied).
+    pub fn image<'a>(self, image: &'a Image) -> std::borrow::Cow<'a, Image> {
+        match self {
+            ToneMap::Linear => std::borrow::Cow::Borrowed(image),
+            _ => std::borrow::Cow::Owned(Image {
+                width: image.width,
+                height: image.height,
+                pixels: image.pixels.iter().map(|&p| self.apply(p)).collect(),
+            }),
+        }
+    }
+}
+
+/// Khronos PBR Neutral: colours below 0.76 pass unchanged (but for a small offset near black),
+/// brighter ones are compressed towards 1 and desaturated. The constants are the published
+/// curve's (start of compression 0.8 − 0.04, desaturation 0.15).
+fn pbr_neutral(c: Vec3) -> Vec3 {
+    const START: f32 = 0.8 - 0.04;
+    const DESATURATION: f32 = 0.15;
+    let x = c.min_element();
+    let offset = if x < 0.08 { x - 6.25 * x * x } else { 0.04 };
+    let c = c - Vec3::splat(offset);
+    let peak = c.max_element();
+    if peak < START {
+        return c;
+    }
+    let d = 1.0 - START;
+    let new_peak = 1.0 - d * d / (peak + d - START);
+    let c = c * (new_peak / peak);
+    let g = 1.0 - 1.0 / (DESATURATION * (peak - new_peak) + 1.0);
+    c.lerp(Vec3::splat(new_peak), g)
+}
+
+/// The sRGB transfer function (IEC 61966-2-1) of a linear value in [0, 1].
+fn srgb_encode(x: f32) -> f32 {
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
 /// A linear RGB image, row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
@@ -344,5 +423,33 @@ mod tests {
         assert_eq!(e.kind(), io::ErrorKind::BrokenPipe);
         let e = Image::new(4, 4).write_pfm(ClosedPipe).unwrap_err();
         assert_eq!(e.kind(), io::ErrorKind::BrokenPipe);
+    }
+}
+
+#[cfg(test)]
+mod tone_tests {
+    use super::*;
+
+    /// The neutral curve leaves mid tones alone (but for its 0.04 offset), keeps order, and
+    /// brings any radiance, however bright, within [0, 1]; linear images are not copied.
+    #[test]
+    fn neutral_keeps_mid_tones_and_bounds_highlights() {
+        let mid = pbr_neutral(Vec3::new(0.5, 0.3, 0.2));
+        assert!((mid - Vec3::new(0.46, 0.26, 0.16)).length() < 1e-6);
+        let mut last = -1.0;
+        for i in 0..2000 {
+            let x = i as f32 * 0.01;
+            let y = ToneMap::Neutral.apply(Vec3::splat(x)).x;
+            assert!(y >= last && (0.0..=1.0).contains(&y), "{x}: {y}");
+            last = y;
+        }
+        assert!(ToneMap::Neutral.apply(Vec3::splat(f32::MAX)).max_element() <= 1.0);
+        assert_eq!(ToneMap::Neutral.apply(Vec3::new(f32::NAN, 0.0, 0.0)).x, 0.0);
+        assert!((srgb_encode(0.5) - 0.735_357).abs() < 1e-5);
+        let img = Image::new(2, 1);
+        assert!(matches!(
+            ToneMap::Linear.image(&img),
+            std::borrow::Cow::Borrowed(_)
+        ));
     }
 }

@@ -212,6 +212,10 @@ pub(super) struct RenderArgs {
     /// Light position x,y,z (default: the scene's first light).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub(super) light: Option<Vec3>,
+    /// How radiance is shown in PNG and text: none (clamped, the built-in scenes' look) or
+    /// neutral (Khronos PBR Neutral and sRGB, the default for models). PFM stays linear.
+    #[arg(long, value_name = "none|neutral", value_parser = parse_tonemap)]
+    pub(super) tonemap: Option<raytty::image::ToneMap>,
     /// Write to FILE instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub(super) output: Option<PathBuf>,
@@ -262,6 +266,13 @@ pub(super) fn parse_sampler(s: &str) -> Result<Sampler, String> {
         let names: Vec<_> = Sampler::ALL.iter().map(|s| s.name()).collect();
         format!("'{s}' is not a sampler: expected {}", names.join(" or "))
     })
+}
+
+pub(super) fn parse_tonemap(s: &str) -> Result<raytty::image::ToneMap, String> {
+    raytty::image::ToneMap::ALL
+        .into_iter()
+        .find(|t| t.name() == s)
+        .ok_or_else(|| format!("'{s}' is not a tone map: expected none or neutral"))
 }
 
 pub(super) fn parse_stage(s: &str) -> Result<Stage, String> {

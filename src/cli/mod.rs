@@ -230,6 +230,7 @@ fn run_default(
             denoise: Switch::On,
             camera: None,
             light: None,
+            tonemap: None,
             output: None,
             stats: None,
             simd: None,

@@ -166,8 +166,9 @@ pub(super) fn run_render(
             } else {
                 render(&scene, &camera, &lights, &settings, w, h)
             };
+            let tone = args.tonemap.unwrap_or(scene.tone_map());
             let written = match format {
-                Format::Png => frame.image.write_png(&mut out),
+                Format::Png => tone.image(&frame.image).write_png(&mut out),
                 Format::Pfm => frame.image.write_pfm(&mut out),
                 Format::Ansi | Format::Ansi256 | Format::Ascii => {
                     let mode = match format {
@@ -175,7 +176,8 @@ pub(super) fn run_render(
                         Format::Ansi256 => ColorMode::Ansi256,
                         _ => ColorMode::Ascii,
                     };
-                    out.write_all(&encode_text(&CellGrid::from_image(&frame.image, mode)))
+                    let shown = tone.image(&frame.image);
+                    out.write_all(&encode_text(&CellGrid::from_image(&shown, mode)))
                 }
             };
             (frame.stats, written)

@@ -18,6 +18,7 @@ use rayon::prelude::*;
 use crate::accel::{Accel, AccelKind, AccelStats, Hit, Isa, TileCache};
 use crate::camera::Camera;
 use crate::geometry::{Aabb, DegenerateTriangle, Ray, RayTile, Triangle};
+use crate::image::ToneMap;
 use crate::sampler::Sampler;
 
 /// Largest absolute coordinate accepted anywhere a user gives one (scene files, OBJ vertices,
@@ -113,6 +114,7 @@ pub struct Scene {
     has_mirrors: bool,
     default_lights: bool,
     step: f32,
+    tone_map: ToneMap,
 }
 
 /// Why a scene could not be built.
@@ -166,6 +168,7 @@ pub struct SceneBuilder {
     drop_degenerate: bool,
     default_lights: bool,
     step: Option<f32>,
+    tone_map: ToneMap,
 }
 
 /// Stands in for a degenerate triangle while validating; never part of a scene.
@@ -219,6 +222,11 @@ impl SceneBuilder {
     /// steps (default 1).
     pub fn step(&mut self, scale: f32) {
         self.step = Some(scale);
+    }
+
+    /// How the scene's frames are shown (default [`ToneMap::Linear`], the seed's look).
+    pub fn tone_map(&mut self, t: ToneMap) {
+        self.tone_map = t;
     }
 
     /// Adds a light.
@@ -340,6 +348,7 @@ impl SceneBuilder {
                 .step
                 .filter(|s| s.is_finite() && *s > 0.0)
                 .unwrap_or(1.0),
+            tone_map: self.tone_map,
         })
     }
 }
@@ -376,6 +385,12 @@ impl Scene {
     /// steps: 1 for the built-in scenes and scene files, a model's size over the box's.
     pub fn step(&self) -> f32 {
         self.step
+    }
+
+    /// How the scene's frames are shown on a screen (PNG, the terminal): linear and clamped
+    /// for the built-in scenes and scene files, Khronos PBR Neutral and sRGB for models.
+    pub fn tone_map(&self) -> ToneMap {
+        self.tone_map
     }
 
     /// Whether the lights are the default rig, put in because the model's file has none.

@@ -270,7 +270,8 @@ impl Screen {
             }
             g
         } else {
-            let mut g = CellGrid::from_image(&self.image, app.color);
+            let shown = app.scene.tone_map().image(&self.image);
+            let mut g = CellGrid::from_image(&shown, app.color);
             let status = blank(cols, 1, app.color);
             g.rows += 1;
             g.cells.extend(status.cells);

@@ -243,6 +243,7 @@ impl Model {
             b.light(l);
         }
         b.default_lights(default_lights);
+        b.tone_map(crate::image::ToneMap::Neutral);
         // The Cornell box's diagonal is 2·√3: the keys' steps are the box's, scaled.
         b.step((bounds.1 - bounds.0).length() / (2.0 * 3f32.sqrt()));
         let mut notes = self.notes;
