@@ -76,8 +76,25 @@ fn gltf_nodes_are_transformed() {
     );
     let h = std::f32::consts::FRAC_1_SQRT_2 * 1.5;
     assert!((child - Vec3::new(h, 0.5, -h)).length() < 1e-4, "{child}");
-    // Vertex colours times the base colour factor give materials of their own.
+    // Vertex colours times the base colour factor (1, 0.9, 0.8) give materials of their own:
+    // the +x faces' red is the factor's full 1 (the default material's grey would give 0.8).
     assert!(s.materials().len() > 1);
+    let reddest = s
+        .triangles()
+        .iter()
+        .map(|t| s.materials()[t.material as usize].colour.x);
+    assert_eq!(reddest.fold(0.0, f32::max), 1.0);
+}
+
+/// The Khronos sample Box (CC BY 4.0, its licence beside it): a red cube turned from z-up.
+#[test]
+fn the_khronos_box_is_red() {
+    let s = load("khronos-box/Box.gltf").scene;
+    assert_eq!(s.triangles().len(), 12);
+    for t in s.triangles() {
+        let c = s.materials()[t.material as usize].colour;
+        assert!((c - Vec3::new(0.8, 0.0, 0.0)).length() < 1e-6, "{c}");
+    }
 }
 
 #[test]

@@ -420,9 +420,7 @@ fn primitive(
     check_triangles(model.triangles.len(), triangles)?;
     let base = first as u32;
     let material = p.material().index().map_or(0, |i| i as u32 + 1);
-    if material != 0 || !model.triangle_materials.is_empty() {
-        model.triangle_materials.resize(model.triangles.len(), 0);
-    }
+    let start = model.triangles.len();
     for k in 0..triangles {
         let t = match mode {
             Mode::Triangles => [indices[3 * k], indices[3 * k + 1], indices[3 * k + 2]],
@@ -433,7 +431,9 @@ fn primitive(
         };
         model.triangles.push(t.map(|i| base + i));
     }
-    if !model.triangle_materials.is_empty() {
+    // Materials are listed once any triangle has one but the default (0).
+    if material != 0 || !model.triangle_materials.is_empty() {
+        model.triangle_materials.resize(start, 0);
         model
             .triangle_materials
             .resize(model.triangles.len(), material);
