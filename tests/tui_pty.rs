@@ -68,7 +68,7 @@ impl Session {
             })
             .expect("open a pty");
         let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_raytty"));
-        cmd.args(["--color", "truecolor"]);
+        cmd.args(["--color", "truecolor", "--cells", "half"]);
         cmd.args(args);
         cmd.env("TERM", term);
         cmd.env_remove("NO_COLOR");

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
+use raytty::frame::CellMode;
 use raytty::sampler::Sampler;
 use raytty::scene::MAX_COORDINATE;
 use raytty::simd::Isa;
@@ -24,6 +25,12 @@ pub struct Cli {
     /// ssh does not forward COLORTERM: pass --color truecolor (or press C) to get it back.
     #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
     pub(super) color: ColorChoice,
+    /// Pixels a cell shows in the app: auto (half unless the terminal is known to draw the
+    /// finer block glyphs itself: sextant in kitty, WezTerm and foot, octant in Ghostty 1.1 or
+    /// later), half (1×2, `▀`), quadrant (2×2), sextant (2×3) or octant (2×4, Unicode 16). A
+    /// font without the glyphs shows boxes: press B to cycle back.
+    #[arg(long, value_enum, default_value_t = CellsChoice::Auto)]
+    pub(super) cells: CellsChoice,
     /// The scene: a scene file (a path that exists or ends in .toml) or a built-in scene's name
     /// (`raytty scenes` lists them). Default: the Cornell box.
     #[arg(long, global = true, value_name = "PATH|NAME")]
@@ -83,6 +90,72 @@ pub(super) enum ColorChoice {
     Ansi256,
     /// No colour escapes at all.
     Ascii,
+}
+
+/// The `--cells` choices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(super) enum CellsChoice {
+    /// Decide from TERM, TERM_PROGRAM and the like.
+    Auto,
+    /// 1×2 pixels a cell (`▀`, in every font).
+    Half,
+    /// 2×2 pixels a cell (quadrant blocks).
+    Quadrant,
+    /// 2×3 pixels a cell (sextants, Unicode 13).
+    Sextant,
+    /// 2×4 pixels a cell (octants, Unicode 16).
+    Octant,
+}
+
+/// What the terminal is known to be, from its environment variables.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct TermEnv<'a> {
+    /// `TERM`.
+    pub(super) term: Option<&'a str>,
+    /// `TERM_PROGRAM`.
+    pub(super) program: Option<&'a str>,
+    /// `TERM_PROGRAM_VERSION`.
+    pub(super) version: Option<&'a str>,
+    /// `KITTY_WINDOW_ID` is set (kitty sets it; TERM may have been changed, e.g. over ssh).
+    pub(super) kitty: bool,
+}
+
+/// The cell mode for `choice`. Auto picks half-blocks unless the terminal draws the finer
+/// glyphs itself rather than from a font (which may lack them and show boxes instead):
+/// - Ghostty 1.1 and later (`TERM_PROGRAM=ghostty`, its version in `TERM_PROGRAM_VERSION`):
+///   its sprite font has the Unicode 16 octants: octant;
+/// - kitty (`TERM=xterm-kitty` or `KITTY_WINDOW_ID`), WezTerm (`TERM_PROGRAM=WezTerm`) and
+///   foot (`TERM=foot…`) draw the sextants themselves: sextant. foot draws octants from 1.20,
+///   but no variable tells foot's version (it would take an XTVERSION query); kitty's and
+///   WezTerm's releases with octants cannot be told from their environment either;
+/// - anything else (xterm, VTE, tmux, screen, the Linux console, an unknown TERM): half.
+pub(super) fn resolve_cells(choice: CellsChoice, env: TermEnv) -> CellMode {
+    match choice {
+        CellsChoice::Half => CellMode::Half,
+        CellsChoice::Quadrant => CellMode::Quadrant,
+        CellsChoice::Sextant => CellMode::Sextant,
+        CellsChoice::Octant => CellMode::Octant,
+        CellsChoice::Auto => {
+            let term = env.term.unwrap_or("");
+            // Inside tmux or screen, the outer terminal's variables may leak through but the
+            // multiplexer redraws the cells in its own terminal: trust only TERM.
+            if term.starts_with("tmux") || term.starts_with("screen") {
+                return CellMode::Half;
+            }
+            let version = |v: Option<&str>| -> (u32, u32) {
+                let mut parts = v.unwrap_or("").split(['.', '-']);
+                let mut next = || parts.next().and_then(|p| p.parse().ok()).unwrap_or(0);
+                (next(), next())
+            };
+            match env.program {
+                Some("ghostty") if version(env.version) >= (1, 1) => CellMode::Octant,
+                Some("ghostty" | "WezTerm") => CellMode::Sextant,
+                _ if term == "xterm-kitty" || env.kitty => CellMode::Sextant,
+                _ if term.starts_with("foot") => CellMode::Sextant,
+                _ => CellMode::Half,
+            }
+        }
+    }
 }
 
 /// The colour mode for `choice`, given whether NO_COLOR is set (and not empty) and COLORTERM.
@@ -162,6 +235,10 @@ pub(super) enum Format {
     Png,
     /// Linear float PFM image.
     Pfm,
+    /// The kitty graphics protocol: one image of --pixels WxH (zlib-compressed RGB).
+    Kitty,
+    /// Sixel: one image of --pixels WxH with a palette of up to 256 colours.
+    Sixel,
 }
 
 /// An on/off switch.
@@ -191,6 +268,11 @@ pub(super) struct RenderArgs {
     /// or ascii. For text frames only.
     #[arg(long, value_enum, conflicts_with = "format")]
     pub(super) color: Option<ColorChoice>,
+    /// Pixels a text cell shows: half (the default: 1×2, `▀`), quadrant (2×2), sextant (2×3),
+    /// octant (2×4, Unicode 16), or auto (as the app decides, from TERM and TERM_PROGRAM).
+    /// --size COLSxROWS is then rendered at COLS·w × ROWS·h pixels. For ansi and ansi256.
+    #[arg(long, value_enum)]
+    pub(super) cells: Option<CellsChoice>,
     /// Shading stage: flat, light, direct, shadows, indirect (the default) or gi.
     #[arg(long, value_parser = parse_stage, default_value = "indirect")]
     pub(super) stage: Stage,

@@ -41,13 +41,23 @@ pub fn main() -> u8 {
     let color = resolve(cli.color);
     let view = cli.view.view();
     let scene = cli.scene.as_deref().or(cli.file.as_deref());
+    let term = std::env::var("TERM").ok();
+    let program = std::env::var("TERM_PROGRAM").ok();
+    let version = std::env::var("TERM_PROGRAM_VERSION").ok();
+    let env = TermEnv {
+        term: term.as_deref(),
+        program: program.as_deref(),
+        version: version.as_deref(),
+        kitty: std::env::var_os("KITTY_WINDOW_ID").is_some(),
+    };
     let result = match cli.command {
         Some(Command::Render(args)) => {
             let colors = RenderColor {
                 own: args.color.map(resolve),
                 inherited: color_given.map(resolve),
             };
-            run_render(&args, scene, &view, no_color, colors).map(|()| 0)
+            let cells = args.cells.map(|c| resolve_cells(c, env));
+            run_render(&args, scene, &view, no_color, colors, cells).map(|()| 0)
         }
         Some(Command::Scenes) => stdout_is_open("the list").and_then(|()| {
             io::stdout()
@@ -58,7 +68,7 @@ pub fn main() -> u8 {
         Some(Command::Bench(a)) => stdout_is_open("the table")
             .and_then(|()| run_bench(a, scene, &view))
             .map(|()| 0),
-        None => run_default(color, scene, &view, dumb),
+        None => run_default(color, resolve_cells(cli.cells, env), scene, &view, dumb),
     };
     match result {
         Ok(code) => code,
@@ -192,6 +202,7 @@ fn is_dumb(term: Option<&str>) -> bool {
 /// as `raytty render` with its defaults would print in `color`.
 fn run_default(
     color: ColorMode,
+    cells: raytty::frame::CellMode,
     scene: Option<&str>,
     view: &raytty::scene::model::View,
     dumb: bool,
@@ -212,18 +223,19 @@ fn run_default(
             if note {
                 eprint!("\r\x1b[2K");
             }
-            return Ok(crate::tui::run(loaded?, color).map(app_status)?);
+            return Ok(crate::tui::run(loaded?, color, cells).map(app_status)?);
         }
         eprintln!("raytty: TERM=dumb cannot run the app (it moves the cursor): one frame follows");
     }
     #[cfg(not(feature = "tui"))]
-    let _ = dumb;
+    let _ = (dumb, cells);
     run_render(
         &RenderArgs {
             size: Some((80, 24)),
             pixels: None,
             format: Some(text_format(color)),
             color: None,
+            cells: None,
             stage: Stage::Indirect,
             samples: None,
             sampler: None,
@@ -239,6 +251,7 @@ fn run_default(
         view,
         false,
         RenderColor::default(),
+        None,
     )?;
     Ok(0)
 }

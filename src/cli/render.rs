@@ -7,6 +7,7 @@ use std::sync::{Mutex, PoisonError};
 use anyhow::Context;
 use clap::ValueEnum;
 use glam::Vec3;
+use raytty::frame::{CellMode, encode_kitty, encode_sixel};
 use raytty::image::{pfm_band_offset, pfm_header, write_pfm_rows};
 use raytty::render::{denoises, render_denoised, render_streamed};
 use raytty::{CellGrid, ColorMode, PointLight, Scene, encode_text, render};
@@ -27,13 +28,14 @@ pub(super) struct RenderColor {
 }
 
 /// `raytty render`; `no_color` (NO_COLOR is set) makes ascii the default text format, and
-/// `color` picks the text format when `--format` is not given.
+/// `color` picks the text format when `--format` is not given; `cells` is `--cells`, resolved.
 pub(super) fn run_render(
     args: &RenderArgs,
     scene: Option<&str>,
     view: &raytty::scene::model::View,
     no_color: bool,
     color: RenderColor,
+    cells: Option<CellMode>,
 ) -> Result<()> {
     if let Some(ext) = args.output.as_deref().and_then(unwritable_image_extension) {
         usage!(
@@ -60,6 +62,13 @@ pub(super) fn run_render(
         },
         (None, None, f) => f,
     };
+    if cells.is_some() && !matches!(format, Format::Ansi | Format::Ansi256) {
+        usage!(
+            "--cells picks the glyphs of a text frame in colour, and --format {} is not one: use --format ansi or ansi256",
+            format_name(format)
+        );
+    }
+    let cells = cells.unwrap_or_default();
     let image_format = matches!(format, Format::Png | Format::Pfm);
     if image_format && args.output.is_none() && io::stdout().is_terminal() {
         usage!(
@@ -67,17 +76,23 @@ pub(super) fn run_render(
             format_name(format)
         );
     }
-    let (w, h) = match (args.pixels, args.size, image_format) {
+    let pictures = image_format || matches!(format, Format::Kitty | Format::Sixel);
+    let (cw, ch) = cells.render_pixels();
+    let (w, h) = match (args.pixels, args.size, pictures) {
         (Some(p), _, _) => p,
-        (None, Some((cols, rows)), _) => (cols, rows * 2),
+        (None, Some((cols, rows)), true) => (cols, rows * 2),
+        (None, Some((cols, rows)), false) => (cols * cw, rows * ch),
         (None, None, true) => (500, 500),
-        (None, None, false) => (80, 48),
+        (None, None, false) => (80 * cw, 24 * ch),
     };
     let pixels = w as u64 * h as u64;
     if pixels > MAX_PIXELS {
         let asked = match args.pixels {
             Some(_) => format!("--pixels {w}x{h} is"),
-            None => format!("--size {}x{} is {w}x{h} =", w, h / 2),
+            None => {
+                let (cols, rows) = args.size.unwrap_or((80, 24));
+                format!("--size {cols}x{rows} is {w}x{h} =")
+            }
         };
         usage!(
             "{asked} {pixels} pixels, about {} MiB of memory; the limit is {MAX_PIXELS} pixels (e.g. --pixels 8192x8192 or --size 8192x4096)",
@@ -177,7 +192,17 @@ pub(super) fn run_render(
                         _ => ColorMode::Ascii,
                     };
                     let shown = tone.image(&frame.image);
-                    out.write_all(&encode_text(&CellGrid::from_image(&shown, mode)))
+                    out.write_all(&encode_text(&CellGrid::from_image_in(&shown, mode, cells)))
+                }
+                Format::Kitty | Format::Sixel => {
+                    let mut bytes = Vec::new();
+                    let encode = match format {
+                        Format::Kitty => encode_kitty,
+                        _ => encode_sixel,
+                    };
+                    encode(&tone.image(&frame.image).to_rgb8(), w, h, &mut bytes);
+                    bytes.push(b'\n');
+                    out.write_all(&bytes)
                 }
             };
             (frame.stats, written)

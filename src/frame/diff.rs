@@ -2,23 +2,25 @@
 //! within a tolerance, optionally within a byte budget. Cheaper than a cell-by-cell repaint:
 //! - unchanged cells are skipped, with the shortest cursor move (`CUF`, `CR LF`, `CUP`, ...);
 //! - a short unchanged run is rewritten instead when that costs fewer bytes than the move;
-//! - a block cell is drawn whichever way the pen's colours carry over best: `▀` (upper pixel
-//!   as foreground) or `▄` (lower pixel as foreground), and a cell of one colour as a space
-//!   (background) or `█` (foreground);
+//! - a block cell is drawn whichever way the pen's colours carry over best: its glyph with the
+//!   ink as foreground, or the complement's glyph with the colours swapped (`▀` or `▄` for a
+//!   half-block; every quadrant, sextant and octant has its complement), and a cell of one
+//!   colour as a space (background) or `█` (foreground);
 //! - one SGR sets the foreground and the background together, and only what changes;
 //! - block cells are sent in the order that reuses the pen's colours most, across the whole
 //!   screen (`exact.rs`); within a tolerance, with colours rounded to a lattice of that
 //!   spacing, so that neighbours share them exactly.
 
-use super::{Cell, CellGrid, Colour, Pen, UPPER_HALF, WIDE_TAIL, half_block, write_char};
+use super::cells::{FULL_SHAPE, glyph_for_shape, shape};
+use super::{Cell, CellGrid, Colour, Pen, WIDE_TAIL, write_char};
 
 /// The lower-half block: its foreground paints the cell's lower pixel.
 pub const LOWER_HALF: char = '▄';
 /// The full block: its foreground paints both pixels.
 pub const FULL_BLOCK: char = '█';
 
-/// How far a cell on screen may be from the frame's: a cell is sent if any channel of either
-/// of its pixels differs by more than `tolerance` levels (0: exact), or if it differs in any
+/// How far a cell on screen may be from the frame's: a cell is sent if any channel of any of
+/// its pixels differs by more than `tolerance` levels (0: exact), or if it differs in any
 /// way that is not a colour level (a character, a palette colour).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DiffLimits {
@@ -55,19 +57,28 @@ pub struct DiffOutcome {
 /// The distance between two cells that differ in more than colour levels.
 pub const UNLIKE: u16 = 256;
 
-/// The two pixels a block cell shows (`▀`, or a space with a background), if it is one.
+/// The two colours a block cell shows, ink and background (`▀`, any other block glyph of the
+/// cell modes, or a space with a background: then both are the background), if it is one.
 pub fn pixels(cell: &Cell) -> Option<(Colour, Colour)> {
     match (cell.ch, cell.fg, cell.bg) {
-        (UPPER_HALF, Some(f), Some(b)) => Some((f, b)),
         (' ', _, Some(b)) => Some((b, b)),
+        (ch, Some(f), Some(b)) if shape(ch).is_some_and(|s| s != FULL_SHAPE) => Some((f, b)),
         _ => None,
     }
 }
 
-/// How far apart two cells look: 0 if alike, the largest channel difference of the two
-/// pixels of truecolor block cells, else [`UNLIKE`].
+/// A block cell's ink shape (see [`shape`]: a space has none) and its two colours.
+fn picture(cell: &Cell) -> Option<(u32, Colour, Colour)> {
+    let (f, b) = pixels(cell)?;
+    Some((if cell.ch == ' ' { 0 } else { shape(cell.ch)? }, f, b))
+}
+
+/// How far apart two cells look: 0 if alike; for truecolor block cells, the largest channel
+/// difference between the colours they show at any place of the cell (both cut on the finest
+/// grid of [`super::SHAPE_ROWS`] rows, so cells of different modes compare too); else
+/// [`UNLIKE`].
 pub fn distance(a: &Cell, b: &Cell) -> u16 {
-    match (pixels(a), pixels(b)) {
+    match (picture(a), picture(b)) {
         (Some(pa), Some(pb)) => {
             if pa == pb {
                 return 0;
@@ -82,7 +93,18 @@ pub fn distance(a: &Cell, b: &Cell) -> u16 {
                 _ if x == y => 0,
                 _ => UNLIKE,
             };
-            d(pa.0, pb.0).max(d(pa.1, pb.1))
+            let (sa, sb) = (pa.0, pb.0);
+            [
+                (sa & sb, pa.1, pb.1),
+                (sa & !sb, pa.1, pb.2),
+                (!sa & sb, pa.2, pb.1),
+                (!sa & !sb & FULL_SHAPE, pa.2, pb.2),
+            ]
+            .into_iter()
+            .filter(|&(place, _, _)| place != 0)
+            .map(|(_, x, y)| d(x, y))
+            .max()
+            .unwrap_or(0)
         }
         _ if a == b => 0,
         _ => UNLIKE,
@@ -222,7 +244,22 @@ fn quantize(cell: &Cell, tolerance: u8) -> Cell {
         c => c,
     };
     match pixels(cell) {
-        Some((up, lo)) if tolerance > 0 => half_block(round(up), round(lo)),
+        Some((ink, bg)) if tolerance > 0 => {
+            let (ink, bg) = (round(ink), round(bg));
+            if ink == bg {
+                Cell {
+                    ch: ' ',
+                    fg: None,
+                    bg: Some(bg),
+                }
+            } else {
+                Cell {
+                    ch: cell.ch,
+                    fg: Some(ink),
+                    bg: Some(bg),
+                }
+            }
+        }
         _ => *cell,
     }
 }
@@ -238,14 +275,16 @@ struct Writer {
 /// One way to draw a cell: the character, and the colours it needs (`None`: any).
 type Way = (char, Option<Colour>, Option<Colour>);
 
-/// The ways to draw `cell` that look the same: two for a block cell, one for text.
+/// The ways to draw `cell` that look the same: two for a block cell (its glyph, and its
+/// complement's with the colours swapped), one for text.
 fn ways(cell: &Cell) -> [Way; 2] {
-    match pixels(cell) {
-        Some((u, l)) if u == l => [(' ', None, Some(u)), (FULL_BLOCK, Some(u), None)],
-        Some((u, l)) => [
-            (UPPER_HALF, Some(u), Some(l)),
-            (LOWER_HALF, Some(l), Some(u)),
-        ],
+    match picture(cell) {
+        Some((_, u, l)) if u == l => [(' ', None, Some(u)), (FULL_BLOCK, Some(u), None)],
+        Some((s, u, l)) => {
+            let other = glyph_for_shape(!s & FULL_SHAPE)
+                .map_or((cell.ch, Some(u), Some(l)), |g| (g, Some(l), Some(u)));
+            [(cell.ch, Some(u), Some(l)), other]
+        }
         None => [(cell.ch, cell.fg, cell.bg); 2],
     }
 }

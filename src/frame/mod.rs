@@ -1,8 +1,13 @@
-//! Frame encoding: an image becomes a grid of terminal cells (one cell = two pixels stacked),
-//! and a grid becomes bytes, either as a whole text frame or as the difference from the frame
-//! the terminal already shows. Pure functions: no terminal, no I/O.
+//! Frame encoding: an image becomes a grid of terminal cells (one cell = two pixels stacked, or
+//! 2×2, 2×3 or 2×4 of them in the other [`CellMode`]s), and a grid becomes bytes, either as a
+//! whole text frame or as the difference from the frame the terminal already shows; or an
+//! image becomes one picture in a pixel protocol ([`encode_kitty`], [`encode_sixel`]). Pure
+//! functions: no terminal, no I/O.
 
+mod cells;
 mod diff;
+mod kitty;
+mod sixel;
 
 use std::io::Write;
 
@@ -10,6 +15,11 @@ pub use diff::{
     DiffLimits, DiffOutcome, FULL_BLOCK, LOWER_HALF, UNLIKE, distance, encode_diff,
     encode_diff_within, pixels,
 };
+
+pub use kitty::encode_kitty;
+pub use sixel::{encode_sixel, palette as sixel_palette};
+
+pub use cells::{CellMode, FULL_SHAPE, SHAPE_ROWS, cell_pixels, glyph_for_shape, paint, shape};
 
 use crate::image::Image;
 
@@ -87,45 +97,11 @@ pub struct CellGrid {
 }
 
 impl CellGrid {
-    /// Turns an image of `cols × 2·rows` pixels into `cols × rows` cells. An odd last pixel row
-    /// is paired with black.
+    /// Turns an image of `cols × 2·rows` pixels into `cols × rows` half-block cells (see
+    /// [`CellGrid::from_image_in`] for the other cell modes). An odd last pixel row is paired
+    /// with black.
     pub fn from_image(image: &Image, mode: ColorMode) -> CellGrid {
-        let cols = image.width as usize;
-        let rows = (image.height as usize).div_ceil(2);
-        let rgb = image.to_rgb8();
-        let px = |x: usize, y: usize| {
-            if y < image.height as usize {
-                rgb[y * cols + x]
-            } else {
-                [0; 3]
-            }
-        };
-        let mut cells = Vec::with_capacity(cols * rows);
-        for r in 0..rows {
-            for x in 0..cols {
-                let (up, lo) = (px(x, 2 * r), px(x, 2 * r + 1));
-                cells.push(match mode {
-                    ColorMode::TrueColor => half_block(
-                        Colour::Rgb(up[0], up[1], up[2]),
-                        Colour::Rgb(lo[0], lo[1], lo[2]),
-                    ),
-                    ColorMode::Ansi256 => half_block(
-                        Colour::Indexed(nearest_256(up)),
-                        Colour::Indexed(nearest_256(lo)),
-                    ),
-                    ColorMode::Ascii => {
-                        let y = (luminance(up) + luminance(lo)) * 0.5;
-                        let i = (y / 255.0 * (ASCII_RAMP.len() - 1) as f32 + 0.5) as usize;
-                        Cell {
-                            ch: ASCII_RAMP[i.min(ASCII_RAMP.len() - 1)] as char,
-                            fg: None,
-                            bg: None,
-                        }
-                    }
-                });
-            }
-        }
-        CellGrid { cols, rows, cells }
+        CellGrid::from_image_in(image, mode, CellMode::Half)
     }
 
     /// The cell at (col, row).
@@ -135,6 +111,7 @@ impl CellGrid {
 }
 
 /// A cell showing `up` over `lo`: a space with only a background when the two are equal.
+#[cfg(test)]
 fn half_block(up: Colour, lo: Colour) -> Cell {
     if up == lo {
         Cell {
@@ -149,6 +126,12 @@ fn half_block(up: Colour, lo: Colour) -> Cell {
             bg: Some(lo),
         }
     }
+}
+
+/// The [`ASCII_RAMP`] character for a luminance of 0..=255.
+fn ramp(y: f32) -> char {
+    let i = (y / 255.0 * (ASCII_RAMP.len() - 1) as f32 + 0.5) as usize;
+    ASCII_RAMP[i.min(ASCII_RAMP.len() - 1)] as char
 }
 
 /// Rec. 709 luminance of an 8-bit colour, 0..=255.
@@ -183,6 +166,37 @@ pub fn nearest_256(c: [u8; 3]) -> u8 {
         232 + gi
     } else {
         16 + 36 * r as u8 + 6 * g as u8 + b as u8
+    }
+}
+
+/// The colour the xterm 256-colour palette gives index `i` (the 16 system colours as xterm's
+/// defaults; the rest are fixed by the palette's formula).
+pub fn palette_rgb(i: u8) -> [u8; 3] {
+    const SYSTEM: [[u8; 3]; 16] = [
+        [0, 0, 0],
+        [205, 0, 0],
+        [0, 205, 0],
+        [205, 205, 0],
+        [0, 0, 238],
+        [205, 0, 205],
+        [0, 205, 205],
+        [229, 229, 229],
+        [127, 127, 127],
+        [255, 0, 0],
+        [0, 255, 0],
+        [255, 255, 0],
+        [92, 92, 255],
+        [255, 0, 255],
+        [0, 255, 255],
+        [255, 255, 255],
+    ];
+    match i {
+        0..=15 => SYSTEM[usize::from(i)],
+        16..=231 => {
+            let k = i - 16;
+            [k / 36, k / 6 % 6, k % 6].map(|l| CUBE[usize::from(l)])
+        }
+        _ => [8 + 10 * (i - 232); 3],
     }
 }
 

@@ -2,6 +2,7 @@
 //! to it is a [`Message`]. No terminal here, so all of it is testable as plain data.
 
 use glam::Vec3;
+use raytty::frame::CellMode;
 use raytty::{Camera, ColorMode, PointLight, Scene, Stage};
 
 /// Everything that can happen to the app.
@@ -25,6 +26,8 @@ pub enum Message {
     Reset,
     /// Next colour mode (truecolor → 256 → ascii).
     CycleColor,
+    /// Next cell mode (half → quadrant → sextant → octant).
+    CycleCells,
     /// Show or hide the key help.
     ToggleHelp,
     /// Turn the GI denoiser on or off.
@@ -58,6 +61,8 @@ pub struct App {
     pub stage: Stage,
     /// How cells are coloured.
     pub color: ColorMode,
+    /// How many pixels a cell shows (half-blocks, quadrants, sextants, octants).
+    pub cells: CellMode,
     /// Whether the key help covers the frame.
     pub help: bool,
     /// Whether the GI stage's indirect light is denoised (the raw, unbiased estimate if not).
@@ -84,6 +89,7 @@ impl App {
             scene,
             stage: Stage::Indirect,
             color,
+            cells: CellMode::Half,
             help: false,
             denoise: true,
             size,
@@ -91,6 +97,16 @@ impl App {
             suspend: false,
             generation: 0,
             dirty: true,
+        }
+    }
+
+    /// The cell mode frames are drawn in: [`App::cells`], but half-blocks in ASCII (one
+    /// character a cell, whatever the mode: finer pixels would only cost render time).
+    pub fn cell_mode(&self) -> CellMode {
+        if self.color == ColorMode::Ascii {
+            CellMode::Half
+        } else {
+            self.cells
         }
     }
 
@@ -161,10 +177,19 @@ pub fn update(app: &mut App, msg: Message) {
             app.lights = app.scene.lights().to_vec();
             true
         }
+        // Into or out of ASCII, the image's size changes unless the cells are half-blocks.
         Message::CycleColor => {
+            let before = app.cell_mode();
             app.color = app.color.next();
             app.dirty = true;
-            false
+            app.cell_mode() != before
+        }
+        // The image is rendered again at the new mode's pixels a cell.
+        Message::CycleCells => {
+            let before = app.cell_mode();
+            app.cells = app.cells.next();
+            app.dirty = true;
+            app.cell_mode() != before
         }
         Message::ToggleHelp => {
             app.help = !app.help;

@@ -32,6 +32,7 @@ pub const KEYS: &[(&str, &str)] = &[
     ("N", "gi: denoiser on / off (off: raw, unbiased)"),
     ("R", "reset camera and light"),
     ("C", "colour mode: truecolor 256 ascii"),
+    ("B", "cells: half quadrant sextant octant"),
     ("H or ?", "this help"),
     ("Ctrl-Z", "suspend (fg resumes)"),
     ("Esc, Ctrl-C", "quit"),
@@ -88,6 +89,7 @@ pub fn message_for(key: KeyEvent) -> Option<Message> {
                 '-' | '_' => Some(Message::Zoom(ZOOM_STEP)),
                 'n' => Some(Message::ToggleDenoise),
                 'c' => Some(Message::CycleColor),
+                'b' => Some(Message::CycleCells),
                 'h' | '?' => Some(Message::ToggleHelp),
                 d @ '1'..='9' => Stage::ALL
                     .get(d as usize - '1' as usize)

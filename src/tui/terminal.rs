@@ -20,6 +20,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use crossterm::event::KeyEvent;
+use raytty::frame::CellMode;
 use raytty::{ColorMode, Scene};
 use signal_hook::consts::{SIGHUP, SIGINT, SIGQUIT, SIGSTOP, SIGTERM, SIGWINCH};
 use signal_hook::iterator::Signals;
@@ -126,7 +127,7 @@ fn suspend() -> Result<()> {
 
 /// Runs the app on the terminal until the user quits, the terminal goes away or a signal
 /// arrives, and says which.
-pub fn run(scene: Scene, color: ColorMode) -> Result<Outcome> {
+pub fn run(scene: Scene, color: ColorMode, cells: CellMode) -> Result<Outcome> {
     let stdin = io::stdin();
     let dev_tty;
     let input: RawFd = if stdin.is_terminal() {
@@ -144,7 +145,9 @@ pub fn run(scene: Scene, color: ColorMode) -> Result<Outcome> {
     spawn_reader_thread(input, tx.clone(), ack_tx);
     let writer = spawn_writer_thread(tx, ack_rx);
     let size = tty::size().context("cannot read the terminal size")?;
-    let outcome = event_loop(App::new(scene, color, size), &rx, &writer);
+    let mut app = App::new(scene, color, size);
+    app.cells = cells;
+    let outcome = event_loop(app, &rx, &writer);
     if matches!(outcome, Ok(Outcome::Quit)) {
         // Let the answers to the last queries come in while raw mode still hides them, so
         // they do not land on the shell's command line.

@@ -7,9 +7,10 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use raytty::bench::timing::ms;
 use raytty::denoise::{Guides, denoise};
-use raytty::frame::{DiffLimits, UNLIKE, distance, encode_diff_within};
+use raytty::frame::{CellMode, DiffLimits, UNLIKE, distance, encode_diff_within};
 use raytty::{
-    Camera, CellGrid, FrameStats, HitCache, Image, Stage, printable, render_cached, render_guided,
+    Camera, CellGrid, ColorMode, FrameStats, HitCache, Image, Stage, printable, render_cached,
+    render_guided,
 };
 
 use super::app::App;
@@ -119,10 +120,12 @@ const APPROXIMATE_FRAMES: usize = 4;
 /// ladder of coarser ones would send most cells again at each rung), then to exact.
 const REFINE_TOLERANCE: u8 = 8;
 
-/// The image size for a terminal of `cols × rows` cells, or `None` if it is too small.
-pub fn image_size(size: (u16, u16)) -> Option<(u32, u32)> {
+/// The image size for a terminal of `cols × rows` cells (the last row is the status line) in
+/// cells of `cells` ([`CellMode::render_pixels`]), or `None` if it is too small.
+pub fn image_size(size: (u16, u16), cells: CellMode) -> Option<(u32, u32)> {
     let (cols, rows) = size;
-    (cols >= MIN_COLS && rows >= MIN_ROWS).then(|| (cols as u32, 2 * (rows as u32 - 1)))
+    let (w, h) = cells.render_pixels();
+    (cols >= MIN_COLS && rows >= MIN_ROWS).then(|| (w * cols as u32, h * (rows as u32 - 1)))
 }
 
 impl Screen {
@@ -161,7 +164,7 @@ impl Screen {
     /// Whether [`Screen::render`] has work to do: the app changed, GI is still refining, or
     /// the denoiser was switched.
     pub fn needs_render(&self, app: &App) -> bool {
-        image_size(app.size).is_some()
+        image_size(app.size, app.cell_mode()).is_some()
             && (self.generation != Some(app.generation)
                 || (app.stage == Stage::Gi
                     && (self.passes < GI_MAX_PASSES || self.shows_denoised != Some(app.denoise))))
@@ -171,7 +174,7 @@ impl Screen {
     /// the app's generation changes, but for a light move, which keeps a bounded history: see
     /// [`LIGHT_MOVE_HISTORY`]). Does nothing if the terminal is too small.
     pub fn render(&mut self, app: &App) {
-        let Some((w, h)) = image_size(app.size) else {
+        let Some((w, h)) = image_size(app.size, app.cell_mode()) else {
             return;
         };
         let mut history = u32::MAX;
@@ -263,7 +266,9 @@ impl Screen {
     pub fn draw(&mut self, app: &App) -> Vec<u8> {
         let start = Instant::now();
         let (cols, rows) = (app.size.0 as usize, app.size.1 as usize);
-        let grid = if image_size(app.size) != Some((self.image.width, self.image.height)) {
+        let grid = if image_size(app.size, app.cell_mode())
+            != Some((self.image.width, self.image.height))
+        {
             let mut g = blank(cols, rows, app.color);
             for (i, variants) in TOO_SMALL.iter().enumerate() {
                 put_text(&mut g, 0, i, longest_that_fits(variants, cols), app.color);
@@ -271,7 +276,7 @@ impl Screen {
             g
         } else {
             let shown = app.scene.tone_map().image(&self.image);
-            let mut g = CellGrid::from_image(&shown, app.color);
+            let mut g = CellGrid::from_image_in(&shown, app.color, app.cell_mode());
             let status = blank(cols, 1, app.color);
             g.rows += 1;
             g.cells.extend(status.cells);
@@ -292,7 +297,7 @@ impl Screen {
             },
         };
         let mut grid = grid;
-        if image_size(app.size) == Some((self.image.width, self.image.height)) {
+        if image_size(app.size, app.cell_mode()) == Some((self.image.width, self.image.height)) {
             self.approximate = limits.tolerance > 0;
             put_line(&mut grid, rows - 1, &self.status(app), app.color);
         }
@@ -369,7 +374,14 @@ impl Screen {
                 },
                 1,
             ),
-            (app.color.name().to_string(), 6),
+            (
+                // The cell mode when it is not the default half-blocks (ASCII has none).
+                match (app.color, app.cells) {
+                    (ColorMode::Ascii, _) | (_, CellMode::Half) => app.color.name().to_string(),
+                    _ => format!("{} {}", app.color.name(), app.cells.name()),
+                },
+                6,
+            ),
             ("H:help".to_string(), 2),
         ];
         fields.retain(|(t, _)| !t.is_empty());

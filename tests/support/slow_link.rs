@@ -79,6 +79,10 @@ impl SlowLink {
         let mut cmd = CommandBuilder::new(program);
         cmd.args(args);
         cmd.env("TERM", "xterm-256color");
+        // Half-blocks whatever terminal the tests run in (`--cells auto` reads these).
+        for var in ["TERM_PROGRAM", "TERM_PROGRAM_VERSION", "KITTY_WINDOW_ID"] {
+            cmd.env_remove(var);
+        }
         cmd.env_remove("NO_COLOR");
         let child = pair.slave.spawn_command(cmd).expect("spawn the program");
         drop(pair.slave);

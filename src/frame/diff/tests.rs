@@ -1,6 +1,7 @@
 //! The diff encoder against a small terminal model that applies what it writes.
 
 use super::*;
+use crate::frame::{UPPER_HALF, half_block};
 
 /// What a cell shows: its two pixels for a block-drawing cell, else its character and
 /// colours (the foreground of a space is invisible).

@@ -1,0 +1,78 @@
+//! The kitty graphics protocol (kitty, WezTerm, Ghostty, Konsole): a frame as one image, its
+//! 8-bit RGB zlib-compressed and base64-encoded in APC escapes (`ESC _ G keys ; data ESC \`) of
+//! at most [`CHUNK`] bytes of data each, as the protocol asks of a terminal's input.
+
+/// Most base64 bytes one escape carries (the protocol's limit; a multiple of 4).
+pub const CHUNK: usize = 4096;
+
+/// zlib level: 6 (zlib's default) makes the seed frame at 400×400 within 1 % of level 9's size
+/// in a third of the time; 1 makes it some 25 % larger.
+const LEVEL: u8 = 6;
+
+/// Appends to `out` the escapes that show `rgb` (`width × height` pixels, row-major) at the
+/// cursor, one pixel to one screen pixel, with the terminal's replies turned off (`q=2`): the
+/// image is sent whole (`a=T`, transmit and display), as 24-bit RGB (`f=24`) compressed with
+/// zlib (`o=z`), in chunks (`m=1` on all but the last).
+pub fn encode_kitty(rgb: &[[u8; 3]], width: u32, height: u32, out: &mut Vec<u8>) {
+    debug_assert_eq!(rgb.len(), width as usize * height as usize);
+    let raw: Vec<u8> = rgb.iter().flatten().copied().collect();
+    let packed = miniz_oxide::deflate::compress_to_vec_zlib(&raw, LEVEL);
+    let text = base64(&packed);
+    let chunks: Vec<&[u8]> = text.chunks(CHUNK).collect();
+    for (i, chunk) in chunks.iter().enumerate() {
+        let more = u8::from(i + 1 < chunks.len());
+        out.extend_from_slice(b"\x1b_G");
+        if i == 0 {
+            out.extend_from_slice(
+                format!("a=T,f=24,o=z,q=2,s={width},v={height},m={more}").as_bytes(),
+            );
+        } else {
+            out.extend_from_slice(format!("m={more}").as_bytes());
+        }
+        out.push(b';');
+        out.extend_from_slice(chunk);
+        out.extend_from_slice(b"\x1b\\");
+    }
+}
+
+/// Standard base64 (RFC 4648, `+/`, padded).
+fn base64(data: &[u8]) -> Vec<u8> {
+    const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = Vec::with_capacity(data.len().div_ceil(3) * 4);
+    for group in data.chunks(3) {
+        let b = [
+            group[0],
+            *group.get(1).unwrap_or(&0),
+            *group.get(2).unwrap_or(&0),
+        ];
+        let n = u32::from(b[0]) << 16 | u32::from(b[1]) << 8 | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= group.len() {
+                out.push(ALPHABET[(n >> (18 - 6 * k) & 63) as usize]);
+            } else {
+                out.push(b'=');
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_matches_the_rfc_examples() {
+        for (plain, coded) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            assert_eq!(base64(plain.as_bytes()), coded.as_bytes());
+        }
+    }
+}
