@@ -1,7 +1,9 @@
 //! Stage 6 and its denoiser, numerically: the raw path is unbiased (many raw frames average to
 //! an independent roulette-free estimate within 1 %), the denoised frame is closer to a
-//! high-sample reference than the raw one, no pixel's filtered light depends on another
-//! object's (silhouettes, mirrors), and the same frame comes out on 1 or 2 threads.
+//! high-sample reference than the raw one, and with many samples it is as right as the raw one
+//! where noise averages away (10×10-pixel block means: the filter's bias would stay there), no
+//! pixel's filtered light depends on another object's (silhouettes, mirrors), and the same
+//! frame comes out on 1 or 2 threads.
 
 use glam::{DVec3, Vec3};
 use raytty::denoise::{Guides, denoise};
@@ -36,6 +38,83 @@ fn guided(scene: &Scene, settings: &Settings, w: u32, h: u32) -> (Image, Guides)
 
 fn rmse(a: &Image, b: &Image) -> f64 {
     raytty::bench::metrics::rmse(a, b)
+}
+
+fn block_rmse(a: &Image, b: &Image) -> f64 {
+    raytty::bench::metrics::block_rmse(a, b, 10)
+}
+
+/// Stage 6 of a built-in scene at `spp` samples, frame `frame`.
+fn gi_of(scene: &Scene, spp: u32, frame: u32) -> Settings {
+    let mut s = Stage::Gi.settings(scene.effects());
+    s.effects.samples = spp;
+    s.frame = frame;
+    s
+}
+
+/// A raw reference of `spp` samples (anti-aliased like the judged frames; its frame number far
+/// from theirs, so its noise is independent).
+fn reference_of(scene: &Scene, w: u32, h: u32, spp: u32) -> Image {
+    let s = gi_of(scene, spp, 1 << 20);
+    render(scene, &scene.camera(), scene.lights(), &s, w, h).image
+}
+
+/// Raw and denoised stage 6 at `spp`.
+fn raw_and_denoised(scene: &Scene, w: u32, h: u32, spp: u32) -> [Image; 2] {
+    let (raw, g) = guided(scene, &gi_of(scene, spp, 0), w, h);
+    [raw, denoise(&g).image]
+}
+
+/// The bias the filter had: at 256 spp, the coloured lights' 10×10-block RMSE was 4.2× the raw
+/// image's here (0.0140 against 0.0033; a luminance-only edge stop that blurred colour, and an
+/// edge-stopping filter's pull towards one side at every edge), and its RMSE was worse than
+/// raw's. Block means keep bias and average noise away, so the denoised blocks must be about
+/// as right as raw's. (The issue's bound, 1.25× at 160×100, is the ignored test below; 40
+/// blocks at this size are a coarser measure, so the bound here is 1.5×.)
+#[test]
+fn with_many_samples_the_denoised_frame_is_as_right_as_the_raw_one_in_blocks() {
+    let scene = builtin::find("lights").unwrap().load().unwrap();
+    let reference = reference_of(&scene, 80, 50, 1024);
+    let [raw, den] = raw_and_denoised(&scene, 80, 50, 256);
+    let (b_raw, b_den) = (block_rmse(&raw, &reference), block_rmse(&den, &reference));
+    let (e_raw, e_den) = (rmse(&raw, &reference), rmse(&den, &reference));
+    eprintln!(
+        "lights 80x50 256 spp: raw {e_raw:.4} / blocks {b_raw:.5}, denoised {e_den:.4} / blocks {b_den:.5}"
+    );
+    assert!(
+        b_den <= 1.5 * b_raw,
+        "denoised block RMSE {b_den:.5} is more than 1.5x raw's {b_raw:.5}"
+    );
+    assert!(e_den < e_raw, "denoised RMSE {e_den:.4} vs raw {e_raw:.4}");
+}
+
+/// The issue's goal on every built-in scene of today's kind, at the issue's size: at 1024 spp
+/// the denoised RMSE is no worse than raw, from 256 spp its block RMSE is at most 1.25× raw's
+/// (against 2048-spp references; several minutes: `cargo test --release --test denoise --
+/// --ignored`).
+#[test]
+#[ignore]
+fn the_denoised_frame_converges_to_the_raw_one_on_every_scene() {
+    for name in ["cornell", "mirror", "lights"] {
+        let scene = builtin::find(name).unwrap().load().unwrap();
+        let reference = reference_of(&scene, 160, 100, 2048);
+        for spp in [256, 1024] {
+            let [raw, den] = raw_and_denoised(&scene, 160, 100, spp);
+            let (b_raw, b_den) = (block_rmse(&raw, &reference), block_rmse(&den, &reference));
+            let (e_raw, e_den) = (rmse(&raw, &reference), rmse(&den, &reference));
+            eprintln!(
+                "{name} {spp} spp: raw {e_raw:.4} / blocks {b_raw:.5}, denoised {e_den:.4} / \
+                 blocks {b_den:.5}"
+            );
+            assert!(
+                b_den <= 1.25 * b_raw,
+                "{name} {spp}: blocks {b_den:.5} vs {b_raw:.5}"
+            );
+            if spp == 1024 {
+                assert!(e_den <= e_raw, "{name}: {e_den:.4} vs {e_raw:.4}");
+            }
+        }
+    }
 }
 
 /// The mean of `frames` one-sample frames (pixel centres), frame numbers from `first`.
@@ -88,8 +167,11 @@ fn the_denoised_frame_is_closer_to_the_reference_than_the_raw_one() {
             e_den < 0.4 * e_raw,
             "{spp} spp: denoised {e_den:.4} is not well below raw {e_raw:.4}"
         );
+        // The filter hands back what it took where that is systematic (so that it converges
+        // to the raw image): at one sample a little of the noise comes back with it (the
+        // bound was 0.04, with a bias that did not fade as samples grew).
         if spp == 1 {
-            assert!(e_den < 0.04, "1 spp denoised RMSE {e_den:.4}");
+            assert!(e_den < 0.045, "1 spp denoised RMSE {e_den:.4}");
         }
         // The raw error estimate from the variance is in the right range.
         let est = f64::from(d.raw_error);

@@ -26,6 +26,37 @@ pub fn rmse(a: &Image, b: &Image) -> f64 {
     (sum / n as f64).sqrt()
 }
 
+/// RMSE of `block`×`block` pixel means (blocks at the right and bottom edges may be smaller):
+/// noise averages away in a block's mean and bias does not, so this is the error a filter's
+/// bias shows in. Both images must have the same size; `block` is at least 1.
+pub fn block_rmse(a: &Image, b: &Image, block: u32) -> f64 {
+    assert_eq!(
+        (a.width, a.height),
+        (b.width, b.height),
+        "image sizes differ"
+    );
+    assert!(block >= 1, "a block has at least one pixel");
+    let (w, h) = (a.width, a.height);
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for by in (0..h).step_by(block as usize) {
+        for bx in (0..w).step_by(block as usize) {
+            let mut d = glam::DVec3::ZERO;
+            let mut count = 0u32;
+            for y in by..(by + block).min(h) {
+                for x in bx..(bx + block).min(w) {
+                    let i = (y * w + x) as usize;
+                    d += (a.pixels[i] - b.pixels[i]).as_dvec3();
+                    count += 1;
+                }
+            }
+            let d = d / f64::from(count);
+            sum += d.dot(d);
+            n += 3;
+        }
+    }
+    if n == 0 { 0.0 } else { (sum / n as f64).sqrt() }
+}
+
 /// Peak signal-to-noise ratio of the 8-bit images (clamped, no gamma, as displayed), in dB:
 /// `10·log10(255²/MSE)`. Infinite when the 8-bit images are equal.
 pub fn psnr8(a: &Image, b: &Image) -> f64 {
@@ -76,5 +107,28 @@ mod tests {
         d.pixels[0] = Vec3::new(2.0, 0.0, 0.0);
         assert!(rmse(&c, &d) > 0.8);
         assert_eq!(psnr8(&c, &d), f64::INFINITY);
+    }
+
+    #[test]
+    fn block_rmse_averages_noise_away_but_not_an_offset() {
+        // A checkerboard of ±0.1 around b: every pixel is off by 0.1, every 2×2 block's mean
+        // is exact.
+        let b = Image::new(4, 3);
+        let mut a = Image::new(4, 3);
+        for (i, p) in a.pixels.iter_mut().enumerate() {
+            let (x, y) = (i % 4, i / 4);
+            *p = Vec3::splat(if (x + y) % 2 == 0 { 0.1 } else { -0.1 });
+        }
+        assert!((rmse(&a, &b) - 0.1).abs() < 1e-7);
+        assert_eq!(block_rmse(&a, &b, 1), rmse(&a, &b));
+        // The last row's blocks are 2×1: +0.1 and −0.1 still cancel.
+        assert!(block_rmse(&a, &b, 2) < 1e-9);
+        // An offset stays in every block's mean.
+        for p in &mut a.pixels {
+            *p += Vec3::new(0.0, 0.3, 0.0);
+        }
+        let want = (0.09f64 / 3.0).sqrt();
+        assert!((block_rmse(&a, &b, 2) - want).abs() < 1e-7);
+        assert!((block_rmse(&a, &b, 10) - want).abs() < 1e-7);
     }
 }
