@@ -21,6 +21,8 @@ pub mod denoise;
 pub mod frame;
 pub mod geometry;
 pub mod image;
+pub mod light;
+pub mod material;
 pub mod render;
 pub mod rng;
 pub mod sampler;

@@ -14,7 +14,7 @@ const LAYERS: &[&[&str]] = &[
     &["sampler", "camera"],
     &["accel"],
     &["scene"],
-    &["material"],
+    &["material", "light"],
     &["shading"],
     &["denoise"],
     &["render"],
