@@ -1,0 +1,100 @@
+//! Writes a raytty scene for Mitsuba 3: its triangles as one Wavefront OBJ per material, and
+//! `scene.json` with the camera, the materials and the point lights in raytty's units (see
+//! `compare.py`, which renders the result with Mitsuba and compares it with raytty's frame).
+//!
+//! `cargo run --release --example mitsuba -- SCENE OUT_DIR` (SCENE: a built-in name or a
+//! scene file).
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use raytty::scene::builtin;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let (Some(name), Some(out)) = (args.get(1), args.get(2)) else {
+        eprintln!("usage: mitsuba SCENE OUT_DIR");
+        std::process::exit(2);
+    };
+    let scene = match builtin::find(name) {
+        Some(b) => b.load().map_err(|e| e.to_string()),
+        None => raytty::scene::file::load(Path::new(name)).map_err(|e| e.to_string()),
+    }
+    .unwrap_or_else(|e| {
+        eprintln!("{name}: {e}");
+        std::process::exit(1);
+    });
+    let out = Path::new(out);
+    std::fs::create_dir_all(out).unwrap();
+    let mut materials = String::new();
+    for (m, mat) in scene.materials().iter().enumerate() {
+        let mut obj = String::new();
+        let mut count = 0;
+        for tri in scene
+            .triangles()
+            .iter()
+            .filter(|t| t.material as usize == m)
+        {
+            for v in tri.v {
+                writeln!(obj, "v {} {} {}", v.x, v.y, v.z).unwrap();
+            }
+            count += 1;
+        }
+        for k in 0..count {
+            // Winding kept: raytty's normal is cross(v2 − v0, v1 − v0); the shading is
+            // two-sided on both sides, so only the triangles matter.
+            writeln!(obj, "f {} {} {}", 3 * k + 1, 3 * k + 2, 3 * k + 3).unwrap();
+        }
+        if count == 0 {
+            continue;
+        }
+        let file = format!("material{m}.obj");
+        std::fs::write(out.join(&file), obj).unwrap();
+        let c = mat.colour;
+        if !materials.is_empty() {
+            materials.push_str(",\n");
+        }
+        write!(
+            materials,
+            "    {{\"obj\": \"{file}\", \"colour\": [{}, {}, {}], \"mirror\": {}, \"triangles\": {count}}}",
+            c.x, c.y, c.z, mat.mirror
+        )
+        .unwrap();
+    }
+    let lights: Vec<String> = scene
+        .lights()
+        .iter()
+        .map(|l| {
+            format!(
+                "    {{\"position\": [{}, {}, {}], \"power\": [{}, {}, {}]}}",
+                l.position.x, l.position.y, l.position.z, l.power.x, l.power.y, l.power.z
+            )
+        })
+        .collect();
+    let cam = scene.camera();
+    let (p, f, d) = (cam.position, cam.forward(), cam.down());
+    let json = format!(
+        "{{\n  \"scene\": \"{name}\",\n  \"camera\": {{\"origin\": [{}, {}, {}], \"forward\": [{}, {}, {}], \
+         \"down\": [{}, {}, {}], \"fov_smaller_side_degrees\": {}}},\n  \"materials\": [\n{materials}\n  ],\n  \
+         \"lights\": [\n{}\n  ]\n}}\n",
+        p.x,
+        p.y,
+        p.z,
+        f.x,
+        f.y,
+        f.z,
+        d.x,
+        d.y,
+        d.z,
+        // The focal length is the shorter side in pixels: 2·atan(1/2) across it.
+        2.0 * 0.5f64.atan().to_degrees(),
+        lights.join(",\n")
+    );
+    std::fs::write(out.join("scene.json"), json).unwrap();
+    eprintln!(
+        "{}: {} triangles, {} lights",
+        out.display(),
+        scene.triangles().len(),
+        scene.lights().len()
+    );
+}
