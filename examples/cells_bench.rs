@@ -127,7 +127,7 @@ fn main() {
 fn encode_times(frame: &dyn Fn(u32, u32) -> Image, runs: Runs) {
     let (cols, rows) = (200, 50);
     println!(
-        "\nencode at {cols}x{rows} cells, median ms\n| mode | cells | text | diff |\n|---|---:|---:|---:|"
+        "\nencode at {cols}x{rows} cells, median CPU ms\n| mode | cells | text | diff |\n|---|---:|---:|---:|"
     );
     for mode in CellMode::ALL {
         let (sw, sh) = mode.render_pixels();

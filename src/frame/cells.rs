@@ -315,8 +315,8 @@ const INV_8: ([[f32; LANES]; 16], [[f32; LANES]; 16]) = (inverses(8, true), inve
 /// has the largest Σ|s|²/k. Ties go to the smallest mask. The sums are whole numbers below
 /// 2^24, exact in `f32`, and each score is the same operations in the same order on every
 /// machine (no FMA). Masks are scored eight at a time (a lane each, [`LANES`]), each lane
-/// keeping its best, so that the compiler vectorises the loop: the cells of a 100×50 octant
-/// frame took 10.5 ms with one running best, 1.2 ms so (`examples/cells_bench`).
+/// keeping its best, so that the compiler vectorises the loop: a 100×50 octant frame's cells
+/// and text took 10.5 ms with one running best, 1.8 ms so (`examples/cells_bench`).
 #[inline(always)]
 fn best_split<const N: usize, const G: usize>(
     px: &[[u8; 3]; N],
@@ -419,7 +419,8 @@ fn cell_for(mode: CellMode, color: ColorMode, (mask, ink, bg): (u8, [u8; 3], [u8
 /// taken as black. Truecolor or 256 colours (each of the two colours its nearest); in ASCII,
 /// the ramp's character for the mean luminance of the cell's pixels. With AVX2, the same code
 /// compiled for it (eight lanes to a register instead of four: the same operations in each
-/// lane, so the same cells, bit for bit): 200×50 octant cells 2.4 -> 1.3 ms of CPU.
+/// lane, so the same cells, bit for bit): 200×50 octant cells 2.4 -> 1.6-1.7 ms of CPU
+/// (`examples/cells_bench`, a loaded machine).
 fn fit_grid(
     rgb: &[[u8; 3]],
     width: usize,
