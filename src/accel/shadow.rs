@@ -54,7 +54,7 @@ use crate::geometry::{Triangle, gamma};
 use crate::simd::Isa;
 
 #[cfg(target_arch = "x86_64")]
-use super::tri4::shadow::any_hit8_in;
+use super::tri4::shadow::any_hit8;
 #[cfg(target_arch = "x86_64")]
 pub use super::tri4::shadow::{ShadowRays8, any_hit8_avx2};
 
@@ -185,22 +185,37 @@ impl ShadowCull {
     /// [`ShadowCull::kept`] with the margin scaled by `scale` (1 in use; the tests show that
     /// 0 drops triangles the scalar test hits).
     pub(crate) fn kept_with_margin(&self, isa: Isa, lo: Vec3, hi: Vec3, scale: f64) -> u64 {
-        self.kept_in::<0>(isa, lo, hi, scale)
+        assert!(isa.available(), "{} is not available", isa.name());
+        #[cfg(target_arch = "x86_64")]
+        if matches!(isa, Isa::Avx2 | Isa::Avx512) {
+            // SAFETY: the CPU has AVX2 (and so AVX).
+            return unsafe { self.kept_avx2(lo, hi, scale) };
+        }
+        self.kept_on(lo, hi, scale, false)
     }
 
-    /// [`ShadowCull::kept_with_margin`] as a copy of its own for each `COPY` (see
-    /// [`ShadowCull::occluded8_in`]).
-    #[inline]
-    pub(crate) fn kept_in<const COPY: u8>(&self, isa: Isa, lo: Vec3, hi: Vec3, scale: f64) -> u64 {
-        // AVX2 implies AVX.
-        let avx = matches!(isa, Isa::Avx2 | Isa::Avx512);
-        assert!(isa.available(), "{} is not available", isa.name());
-        self.kept_on::<COPY>(lo, hi, scale, avx)
+    /// [`ShadowCull::kept_with_margin`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn kept_avx2(&self, lo: Vec3, hi: Vec3, scale: f64) -> u64 {
+        self.kept_on(lo, hi, scale, true)
+    }
+
+    /// [`ShadowCull::kept`] with AVX, inlined into its caller (a kernel compiled for AVX2 or
+    /// AVX-512).
+    ///
+    /// # Safety
+    /// The CPU must have AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub(crate) unsafe fn kept_avx(&self, lo: Vec3, hi: Vec3) -> u64 {
+        self.kept_on(lo, hi, 1.0, true)
     }
 
     /// [`ShadowCull::kept_with_margin`], the plane tests with AVX (which the CPU must have) or
     /// portably: the same answer.
-    fn kept_on<const COPY: u8>(&self, lo: Vec3, hi: Vec3, scale: f64, avx: bool) -> u64 {
+    #[inline(always)]
+    fn kept_on(&self, lo: Vec3, hi: Vec3, scale: f64, avx: bool) -> u64 {
         let l = self.light.map(f32::from_bits).map(f64::from);
         let (lo, hi) = (lo.to_array().map(f64::from), hi.to_array().map(f64::from));
         // `L − o` over the box: centre and half extent (widened for their rounding), and
@@ -232,7 +247,7 @@ impl ShadowCull {
         #[cfg(target_arch = "x86_64")]
         if avx {
             // SAFETY: the caller passes `avx` only where the CPU has it.
-            unsafe { planes_avx::<COPY>(&self.groups, &cu, &ru, m, &mut neg, &mut pos) };
+            unsafe { planes_avx(&self.groups, &cu, &ru, m, &mut neg, &mut pos) };
         }
         for (gi, g) in self.groups.iter().enumerate() {
             if avx {
@@ -268,41 +283,49 @@ impl ShadowCull {
 /// # Safety
 /// The CPU must have AVX.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-#[inline]
+#[inline(always)]
 unsafe fn planes4_avx(g: &Planes4, cu: &[f64; 3], ru: &[f64; 3], m: f64) -> ([u32; 3], [u32; 3]) {
     use std::arch::x86_64::*;
-    // SAFETY: each load reads a whole 32-byte-aligned `[f64; 4]`.
-    let ld = |a: &[f64; 4]| unsafe { _mm256_load_pd(a.as_ptr()) };
-    let (c0, c1, c2) = (
-        _mm256_set1_pd(cu[0]),
-        _mm256_set1_pd(cu[1]),
-        _mm256_set1_pd(cu[2]),
-    );
-    let (r0, r1, r2) = (
-        _mm256_set1_pd(ru[0]),
-        _mm256_set1_pd(ru[1]),
-        _mm256_set1_pd(ru[2]),
-    );
-    let (mut neg, mut pos) = ([0; 3], [0; 3]);
-    let margin = _mm256_set1_pd(m);
-    let below = _mm256_sub_pd(_mm256_setzero_pd(), margin);
-    for p in 0..3 {
-        let n = &g.n[p];
-        let a = &g.abs[p];
-        let f = _mm256_add_pd(
-            _mm256_add_pd(_mm256_mul_pd(ld(&n[0]), c0), _mm256_mul_pd(ld(&n[1]), c1)),
-            _mm256_mul_pd(ld(&n[2]), c2),
+    // SAFETY: the CPU has AVX (this function's contract); each load reads a whole
+    // 32-byte-aligned `[f64; 4]`. (No closure around the loads: this runs inlined into
+    // kernels compiled for AVX2 or AVX-512, and a closure is compiled without them.)
+    unsafe {
+        macro_rules! ld {
+            ($a:expr) => {
+                _mm256_load_pd($a.as_ptr())
+            };
+        }
+        let (c0, c1, c2) = (
+            _mm256_set1_pd(cu[0]),
+            _mm256_set1_pd(cu[1]),
+            _mm256_set1_pd(cu[2]),
         );
-        let s = _mm256_add_pd(
-            _mm256_add_pd(_mm256_mul_pd(ld(&a[0]), r0), _mm256_mul_pd(ld(&a[1]), r1)),
-            _mm256_mul_pd(ld(&a[2]), r2),
+        let (r0, r1, r2) = (
+            _mm256_set1_pd(ru[0]),
+            _mm256_set1_pd(ru[1]),
+            _mm256_set1_pd(ru[2]),
         );
-        neg[p] = _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_add_pd(f, s), below)) as u32;
-        pos[p] =
-            _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(_mm256_sub_pd(f, s), margin)) as u32;
+        let (mut neg, mut pos) = ([0; 3], [0; 3]);
+        let margin = _mm256_set1_pd(m);
+        let below = _mm256_sub_pd(_mm256_setzero_pd(), margin);
+        for p in 0..3 {
+            let n = &g.n[p];
+            let a = &g.abs[p];
+            let f = _mm256_add_pd(
+                _mm256_add_pd(_mm256_mul_pd(ld!(n[0]), c0), _mm256_mul_pd(ld!(n[1]), c1)),
+                _mm256_mul_pd(ld!(n[2]), c2),
+            );
+            let s = _mm256_add_pd(
+                _mm256_add_pd(_mm256_mul_pd(ld!(a[0]), r0), _mm256_mul_pd(ld!(a[1]), r1)),
+                _mm256_mul_pd(ld!(a[2]), r2),
+            );
+            neg[p] =
+                _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_add_pd(f, s), below)) as u32;
+            pos[p] =
+                _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(_mm256_sub_pd(f, s), margin)) as u32;
+        }
+        (neg, pos)
     }
-    (neg, pos)
 }
 
 /// [`planes4_avx`] for every group, into `neg` and `pos` (bit per triangle).
@@ -310,8 +333,8 @@ unsafe fn planes4_avx(g: &Planes4, cu: &[f64; 3], ru: &[f64; 3], m: f64) -> ([u3
 /// # Safety
 /// The CPU must have AVX.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-unsafe fn planes_avx<const COPY: u8>(
+#[inline(always)]
+unsafe fn planes_avx(
     groups: &[Planes4],
     cu: &[f64; 3],
     ru: &[f64; 3],
@@ -348,17 +371,17 @@ impl ShadowCull {
         ray: impl Fn(usize) -> crate::geometry::Ray,
     ) -> u32 {
         // SAFETY: this function's contract.
-        unsafe { self.occluded8_in::<0>(kept, rays, lanes, oz, t_max, ray) }
+        unsafe { self.occluded8(kept, rays, lanes, oz, t_max, ray) }
     }
 
-    /// [`ShadowCull::occluded8_avx2`] as a copy of its own for each `COPY`: the shading kernel
-    /// is compiled twice (AVX2, AVX-512), and a copy per compilation is inlined into it.
+    /// [`ShadowCull::occluded8_avx2`] inlined into its caller (the shading kernel, compiled
+    /// for AVX2 or AVX-512).
     ///
     /// # Safety
     /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    pub(crate) unsafe fn occluded8_in<const COPY: u8>(
+    #[inline(always)]
+    pub(crate) unsafe fn occluded8(
         &self,
         kept: u64,
         rays: &ShadowRays8,
@@ -381,7 +404,7 @@ impl ShadowCull {
                 continue;
             }
             // SAFETY: the CPU has AVX2 (this function's contract).
-            let (hit, redo) = unsafe { any_hit8_in::<COPY>(&t.lanes, rays, t_max) };
+            let (hit, redo) = unsafe { any_hit8(&t.lanes, rays, t_max) };
             blocked |= hit & lanes;
             let mut redo = redo & lanes & !blocked;
             while redo != 0 {
@@ -501,8 +524,8 @@ mod tests {
             let kept = cull.kept(Isa::detect(), lo, hi);
             if Isa::Avx2.available() {
                 assert_eq!(
-                    cull.kept_on::<0>(lo, hi, 1.0, true),
-                    cull.kept_on::<0>(lo, hi, 1.0, false)
+                    cull.kept_on(lo, hi, 1.0, true),
+                    cull.kept_on(lo, hi, 1.0, false)
                 );
             }
             for (i, t) in tris.iter().enumerate() {

@@ -7,15 +7,22 @@ use std::f32::consts::PI;
 use glam::Vec3;
 
 use crate::accel::Hit;
-use crate::geometry::{Ray, RayTile, hit_point, offset_ray_origin};
+use crate::accel::tri4::Best8;
+use crate::geometry::{Ray, RayTile, Triangle};
 use crate::sampler::SampleSource;
 use crate::scene::{Indirect, Material, PointLight, Scene};
 
+mod lane;
+mod light;
 #[cfg(target_arch = "x86_64")]
-mod lanes;
+mod packets;
 mod split;
 mod stage;
+mod surface;
 mod tile;
+
+use lane::{Lanes, Scalar};
+use surface::{Surface, offset_origin, surface};
 
 pub use split::{GuideHit, SplitSample};
 pub use stage::{Mode, RayCounts, Settings, Stage};
@@ -50,9 +57,9 @@ pub struct Tracer<'a> {
     lights: &'a [PointLight],
     settings: Settings,
     min_r2: f32,
-    /// What [`Tracer::shade_tile_lanes`] reads per triangle and light, built on first use.
+    /// Per light, the shadow cull of a small scene's tiles, built on first use.
     #[cfg(target_arch = "x86_64")]
-    tables: std::sync::OnceLock<Box<lanes::Tables>>,
+    culls: std::sync::OnceLock<Vec<crate::accel::shadow::ShadowCull>>,
 }
 
 impl<'a> Tracer<'a> {
@@ -65,7 +72,7 @@ impl<'a> Tracer<'a> {
             settings,
             min_r2: r * r,
             #[cfg(target_arch = "x86_64")]
-            tables: std::sync::OnceLock::new(),
+            culls: std::sync::OnceLock::new(),
         }
     }
 
@@ -130,12 +137,8 @@ impl<'a> Tracer<'a> {
                 ..SplitSample::default()
             };
         }
-        let (p, err) = hit_point(&tri.v, hit.b);
-        let normal = if tri.normal.dot(ray.dir) > 0.0 {
-            -tri.normal
-        } else {
-            tri.normal
-        };
+        let at = surface_of(tri, hit, ray);
+        let (p, normal) = (Vec3::from_array(at.p), Vec3::from_array(at.normal));
         let reflects = material.mirror > 0.0 && mirror_depth < MAX_MIRROR_DEPTH;
         // As in `shade`: a perfect mirror's own shading and a black surface's cost no ray.
         let (direct, irradiance) =
@@ -143,8 +146,8 @@ impl<'a> Tracer<'a> {
                 (Vec3::ZERO, Vec3::ZERO)
             } else {
                 (
-                    self.direct(p, err, normal, n),
-                    self.indirect(material, p, err, normal, mirror_depth, 0, rng, n),
+                    self.direct_at(&at, n),
+                    self.indirect(material, &at, mirror_depth, 0, rng, n),
                 )
             };
         let own = SplitSample {
@@ -162,11 +165,8 @@ impl<'a> Tracer<'a> {
             return own;
         }
         let m = material.mirror;
-        let d = ray.dir.normalize();
-        let dir = d - 2.0 * d.dot(normal) * normal;
-        let origin = offset_ray_origin(p, err, normal, dir);
+        let reflected_ray = mirror_ray(&at, ray);
         n.reflection += 1;
-        let reflected_ray = Ray::new(origin, dir);
         let reflected = match self.scene.intersect(&reflected_ray, f32::INFINITY) {
             Some(h) => self.split(&reflected_ray, &h, mirror_depth + 1, rng, n),
             None => SplitSample::default(),
@@ -219,15 +219,9 @@ impl<'a> Tracer<'a> {
         if self.settings.mode == Mode::Flat {
             return material.colour;
         }
-        let (p, err) = hit_point(&tri.v, hit.b);
-        // Two-sided shading: light the side the ray came from.
-        let normal = if tri.normal.dot(ray.dir) > 0.0 {
-            -tri.normal
-        } else {
-            tri.normal
-        };
+        let at = surface_of(tri, hit, ray);
         if self.settings.mode == Mode::Irradiance {
-            return self.direct(p, err, normal, n);
+            return self.direct_at(&at, n);
         }
         let reflects = material.mirror > 0.0 && mirror_depth < MAX_MIRROR_DEPTH;
         // What cannot change the pixel is not traced: a perfect mirror's own shading is
@@ -235,16 +229,19 @@ impl<'a> Tracer<'a> {
         let diffuse = if (reflects && material.mirror >= 1.0) || material.colour == Vec3::ZERO {
             Vec3::ZERO
         } else {
-            material.colour
-                * (self.direct(p, err, normal, n)
-                    + self.indirect(material, p, err, normal, mirror_depth, bounce, rng, n))
+            let direct = self.direct_at(&at, n);
+            let indirect = self.indirect(material, &at, mirror_depth, bounce, rng, n);
+            let [r, g, b] = diffuse(
+                Scalar,
+                material.colour.to_array(),
+                direct.to_array(),
+                indirect.to_array(),
+            );
+            Vec3::new(r, g, b)
         };
         if reflects {
-            let d = ray.dir.normalize();
-            let dir = d - 2.0 * d.dot(normal) * normal;
-            let origin = offset_ray_origin(p, err, normal, dir);
             n.reflection += 1;
-            let reflected = self.trace(&Ray::new(origin, dir), mirror_depth + 1, bounce, rng, n);
+            let reflected = self.trace(&mirror_ray(&at, ray), mirror_depth + 1, bounce, rng, n);
             diffuse * (1.0 - material.mirror) + reflected * material.mirror
         } else {
             diffuse
@@ -253,13 +250,10 @@ impl<'a> Tracer<'a> {
 
     /// The indirect irradiance at a diffuse hit: the seed's constant, or one path-traced
     /// bounce (with Russian roulette past [`ROULETTE_START`] bounces).
-    #[allow(clippy::too_many_arguments)]
     fn indirect(
         &self,
         material: &Material,
-        p: Vec3,
-        err: Vec3,
-        normal: Vec3,
+        at: &Surface<f32>,
         mirror_depth: u32,
         bounce: u32,
         rng: &mut impl SampleSource,
@@ -280,8 +274,8 @@ impl<'a> Tracer<'a> {
                 if q < 1.0 && rng.next_1d() >= q {
                     Vec3::ZERO
                 } else {
-                    let dir = cosine_sample(normal, rng);
-                    let origin = offset_ray_origin(p, err, normal, dir);
+                    let dir = cosine_sample(Vec3::from_array(at.normal), rng);
+                    let origin = Vec3::from_array(offset_origin(Scalar, at, dir.to_array()));
                     n.bounce += 1;
                     self.trace(&Ray::new(origin, dir), mirror_depth, bounce + 1, rng, n) / q
                 }
@@ -293,55 +287,46 @@ impl<'a> Tracer<'a> {
     /// Direct irradiance at `p` (error bound `err`) on a surface with normal `normal`, summed
     /// over the lights: `D = P·max(r̂·n̂, 0)/(4πr²)`, with `r²` clamped to the scene's minimum
     /// light distance. A light behind the surface contributes nothing and costs no shadow ray.
-    pub fn direct(&self, p: glam::Vec3, err: Vec3, normal: Vec3, n: &mut RayCounts) -> Vec3 {
-        let mut sum = Vec3::ZERO;
-        for light in self.lights {
-            let Some((term, shadow)) = self.light_term(light, p, err, normal) else {
-                continue;
-            };
-            if let Some(ray) = shadow {
-                n.shadow += 1;
-                if self.scene.occluded(&ray, 1.0 - SHADOW_EPSILON) {
-                    continue;
-                }
-            }
-            sum += term;
-        }
-        sum
+    /// The tile kernel at width 1, one point.
+    pub fn direct(&self, p: Vec3, err: Vec3, normal: Vec3, n: &mut RayCounts) -> Vec3 {
+        let at = Surface {
+            p: p.to_array(),
+            err: err.to_array(),
+            normal: normal.to_array(),
+        };
+        self.direct_at(&at, n)
     }
 
-    /// What `light` adds to [`Tracer::direct`] at `p` if nothing blocks it, and the shadow ray
-    /// that decides whether something does (`None`: no ray is traced, the light counts as
-    /// seen). `None` for a light that adds nothing: dark, at `p`, or behind the surface.
-    #[inline(always)]
-    fn light_term(
-        &self,
-        light: &PointLight,
-        p: Vec3,
-        err: Vec3,
-        normal: Vec3,
-    ) -> Option<(Vec3, Option<Ray>)> {
-        // A dark light adds nothing: no shadow ray for it.
-        if light.power == Vec3::ZERO {
+    /// Whether the tile kernel finishes a hit on `triangle` in lanes: in light-only frames
+    /// every hit, in colour frames a surface that is all diffuse ([`diffuse`]) and not black.
+    /// Mirrors and black surfaces (whose own shading costs no ray) and flat colour are shaded
+    /// one ray at a time.
+    #[inline]
+    fn in_lanes(&self, triangle: u32) -> bool {
+        let tri = &self.scene.triangles()[triangle as usize];
+        let material = &self.scene.materials()[tri.material as usize];
+        match self.settings.mode {
+            Mode::Flat => false,
+            Mode::Irradiance => true,
+            Mode::Colour => !(material.mirror > 0.0) && material.colour != Vec3::ZERO,
+        }
+    }
+
+    /// The shadow culls of this frame's lights, for a small scene with shadows (else `None`).
+    #[cfg(target_arch = "x86_64")]
+    fn culls(&self) -> Option<&[crate::accel::shadow::ShadowCull]> {
+        use crate::accel::shadow::{SHADOW_TILE_TRIANGLES, ShadowCull};
+        let tris = self.scene.triangles();
+        if !self.settings.effects.shadows || tris.len() > SHADOW_TILE_TRIANGLES {
             return None;
         }
-        let to_light = light.position - p;
-        let dist2 = to_light.length_squared();
-        if !(dist2 > 0.0) {
-            return None;
-        }
-        let cos = normal.dot(to_light) / dist2.sqrt();
-        if !(cos > 0.0) {
-            return None;
-        }
-        let term = light.power * cos / (4.0 * PI * dist2.max(self.min_r2));
-        if !self.settings.effects.shadows {
-            return Some((term, None));
-        }
-        let origin = offset_ray_origin(p, err, normal, to_light);
-        let dir = light.position - origin;
-        let shadow = (dir != Vec3::ZERO && dir.is_finite()).then(|| Ray::new(origin, dir));
-        Some((term, shadow))
+        let culls = self.culls.get_or_init(|| {
+            self.lights
+                .iter()
+                .map(|l| ShadowCull::new(tris, l.position))
+                .collect()
+        });
+        Some(culls)
     }
 
     /// Whether [`Tracer::shade_tile`] can shade this frame's primary hits: one sample, light
@@ -350,40 +335,35 @@ impl<'a> Tracer<'a> {
         !self.draws_random_numbers()
     }
 
-    /// Whether [`Tracer::shade_tile_best`] shades this frame's tiles (AVX2, a small scene).
+    /// Whether [`Tracer::shade_tile_best`] is the better entry for this frame's tiles: where
+    /// the scene's tile query leaves its hits in lanes as the kernel reads them (the flat list
+    /// of a small scene on AVX2 or AVX-512), rather than as [`Hit`]s.
     pub(crate) fn shades_tile_lanes(&self) -> bool {
-        #[cfg(target_arch = "x86_64")]
-        return self.shades_in_lanes();
-        #[cfg(not(target_arch = "x86_64"))]
-        false
+        matches!(
+            self.scene.isa(),
+            crate::simd::Isa::Avx2 | crate::simd::Isa::Avx512
+        ) && self.scene.triangles().len() <= crate::accel::shadow::SHADOW_TILE_TRIANGLES
     }
 
     /// [`Tracer::shade_tile`] of hits in lanes as [`crate::Scene::intersect_tile_best`] leaves
-    /// them (ray `i`'s in lane `i % 8` of `best[i / 8]`), without putting them in [`Hit`]s
-    /// first. Only where [`Tracer::shades_tile_lanes`] (elsewhere it puts them in `Hit`s for
-    /// [`Tracer::shade_tile`]).
+    /// them (ray `i`'s in lane `i % 8` of `best[i / 8]`).
     pub(crate) fn shade_tile_best(
         &self,
         rays: &RayTile,
-        best: &[crate::accel::tri4::Best8; crate::accel::TILE_RAYS / 8],
+        best: &[Best8; crate::accel::TILE_RAYS / 8],
         out: &mut [Vec3],
         n: &mut RayCounts,
         scratch: &mut TileScratch,
     ) {
-        #[cfg(target_arch = "x86_64")]
-        self.shade_tile_best_lanes(rays, best, out, n, &mut scratch.lanes);
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            let hits: Vec<Option<Hit>> = (0..rays.len()).map(|i| best[i / 8].hit(i % 8)).collect();
-            self.shade_tile(rays, &hits, out, n, scratch);
-        }
+        debug_assert!(self.shades_tiles());
+        self.shade_tile_in(rays, best, out, n, scratch);
     }
 
     /// [`Tracer::shade_primary`] for a tile of primary rays and their hits (at most
     /// [`crate::accel::TILE_RAYS`]), into `out`: the same colours bit for bit and the same rays
-    /// counted, computed light by light across the tile (each pixel's terms still added in the
-    /// lights' order), so that the tile's shadow rays are traced together, not interleaved
-    /// with shading. Only for frames that [`Tracer::shades_tiles`].
+    /// counted, computed light by light across the tile by the tile kernel (each pixel's terms
+    /// still added in the lights' order), so that the tile's shadow rays are traced together,
+    /// not interleaved with shading. Only for frames that [`Tracer::shades_tiles`].
     pub fn shade_tile(
         &self,
         rays: &RayTile,
@@ -394,84 +374,11 @@ impl<'a> Tracer<'a> {
     ) {
         debug_assert!(self.shades_tiles());
         assert!(hits.len() == rays.len() && out.len() == rays.len());
-        #[cfg(target_arch = "x86_64")]
-        if self.shades_in_lanes() {
-            self.shade_tile_lanes(rays, hits, out, n, &mut scratch.lanes);
-            return;
+        let mut best = [Best8::NONE; crate::accel::TILE_RAYS / 8];
+        for (i, &h) in hits.iter().enumerate() {
+            best[i / 8].set(i % 8, h);
         }
-        // Per pixel being shaded here: the hit point, its error, the normal facing the ray,
-        // and where it goes in `out`.
-        let TileScratch {
-            at,
-            sum,
-            terms,
-            rays: shadows,
-            blocked,
-            ..
-        } = scratch;
-        at.clear();
-        for (i, hit) in hits.iter().enumerate() {
-            let Some(hit) = hit else {
-                out[i] = Vec3::ZERO;
-                continue;
-            };
-            let tri = &self.scene.triangles()[hit.triangle as usize];
-            let material = &self.scene.materials()[tri.material as usize];
-            let mode = self.settings.mode;
-            // As `shade`: flat colour; a black surface or a mirror (shaded one at a time).
-            let own = mode == Mode::Irradiance
-                || (mode == Mode::Colour
-                    && !(material.mirror > 0.0)
-                    && material.colour != Vec3::ZERO);
-            if !own {
-                let ray = rays.ray(i);
-                out[i] = self.shade_primary(&ray, Some(*hit), &mut crate::rng::Rng::seeded(0), n);
-                continue;
-            }
-            let (p, err) = hit_point(&tri.v, hit.b);
-            let normal = if tri.normal.dot(rays.dir(i)) > 0.0 {
-                -tri.normal
-            } else {
-                tri.normal
-            };
-            at.push((p, err, normal, i));
-        }
-        sum.clear();
-        sum.resize(at.len(), Vec3::ZERO);
-        for light in self.lights {
-            terms.clear();
-            self.light_terms(light, at, terms);
-            // The tile's shadow rays, traced together.
-            shadows.clear();
-            shadows.extend(terms.iter().filter_map(|t| t.and_then(|(_, s)| s)));
-            blocked.clear();
-            blocked.resize(shadows.len(), false);
-            self.scene
-                .occluded_each(shadows, 1.0 - SHADOW_EPSILON, blocked);
-            n.shadow += shadows.len() as u64;
-            let mut blocked = blocked.iter();
-            for (s, t) in sum.iter_mut().zip(terms.iter()) {
-                let Some((term, shadow)) = t else { continue };
-                if shadow.is_some() && *blocked.next().expect("one answer per shadow ray") {
-                    continue;
-                }
-                *s += *term;
-            }
-        }
-        for (&(.., i), &sum) in at.iter().zip(sum.iter()) {
-            out[i] = if self.settings.mode == Mode::Irradiance {
-                sum
-            } else {
-                let tri = &self.scene.triangles()[hits[i].expect("a hit").triangle as usize];
-                let material = &self.scene.materials()[tri.material as usize];
-                let indirect = match self.settings.effects.indirect {
-                    Indirect::Constant(k) => Vec3::splat(k),
-                    _ => Vec3::ZERO,
-                };
-                material.colour * (sum + indirect)
-            };
-            debug_assert!(out[i].is_finite(), "non-finite colour {}", out[i]);
-        }
+        self.shade_tile_in(rays, &best, out, n, scratch);
     }
 }
 
@@ -479,14 +386,32 @@ impl<'a> Tracer<'a> {
 /// `TileScratch::default()`.
 #[derive(Clone, Debug, Default)]
 pub struct TileScratch {
-    at: Vec<(Vec3, Vec3, Vec3, usize)>,
-    sum: Vec<Vec3>,
-    terms: Vec<Option<(Vec3, Option<Ray>)>>,
-    rays: Vec<Ray>,
-    blocked: Vec<bool>,
-    /// What [`Tracer::shade_tile_lanes`] keeps.
-    #[cfg(target_arch = "x86_64")]
-    lanes: Box<lanes::LaneScratch>,
+    gathered: Box<tile::Gathered>,
+    points: Box<tile::Points<{ crate::accel::TILE_RAYS / 8 }>>,
+    shadows: tile::ShadowScratch,
+}
+
+/// The hit of `ray` on `tri` at `hit`: the tile kernel's [`surface`] at width 1.
+fn surface_of(tri: &Triangle, hit: &Hit, ray: &Ray) -> Surface<f32> {
+    let v = tri.v.map(|v| v.to_array());
+    surface(Scalar, v, tri.normal.to_array(), hit.b, ray.dir.to_array())
+}
+
+/// The mirror reflection of `ray` at `at`.
+fn mirror_ray(at: &Surface<f32>, ray: &Ray) -> Ray {
+    let normal = Vec3::from_array(at.normal);
+    let d = ray.dir.normalize();
+    let dir = d - 2.0 * d.dot(normal) * normal;
+    let origin = offset_origin(Scalar, at, dir.to_array());
+    Ray::new(Vec3::from_array(origin), dir)
+}
+
+/// A diffuse surface of reflectance `rho` (per channel) under `direct` and `indirect`
+/// irradiance: `ρ·(D + N)`, in the seed's units (the BRDF's 1/π dropped). The one place the
+/// tile kernel and one ray at a time shade a diffuse surface.
+#[inline(always)]
+fn diffuse<S: Lanes>(s: S, rho: [S::F; 3], direct: [S::F; 3], indirect: [S::F; 3]) -> [S::F; 3] {
+    lane::each3!(|k| s.mul(rho[k], s.add(direct[k], indirect[k])))
 }
 
 /// A cosine-weighted direction on the hemisphere around `n` (unit length).

@@ -1,303 +1,501 @@
-//! The per-light arithmetic of [`Tracer::shade_tile`] eight pixels at a time: each pixel's
-//! unshadowed term and shadow ray exactly as [`Tracer::light_term`] computes them (the same
-//! `f32` operations in the same order, no fused multiply-add; the next-float steps of
-//! `offset_ray_origin` as integer steps on the bits), with AVX2 on the AVX2 and AVX-512 paths.
+//! The shading kernel: the hits of a tile of primary rays shaded together, as structure of
+//! arrays, [`Lanes::WIDTH`] pixels at a time (eight with AVX2 or AVX-512, one elsewhere). The
+//! hit points ([`surface`]), each light's term and shadow ray ([`super::light`]), the shadow
+//! rays of the whole tile toward one light traced together, the sums over the lights and the
+//! colours. One ray at a time ([`Tracer::direct`]) is this kernel at width 1 with one pixel.
+//!
+//! Surfaces the lanes do not finish (a mirror, a black surface, flat colour: see
+//! [`Tracer::in_lanes`]) are shaded ray by ray first.
 
 use glam::Vec3;
 
-use super::Tracer;
-use crate::geometry::Ray;
-use crate::scene::PointLight;
-use crate::simd::Isa;
-#[cfg(target_arch = "x86_64")]
-use std::arch::x86_64::__m256;
+use super::lane::{Lanes, Scalar, each3};
+use super::light::point_light;
+use super::surface::{Surface, surface};
+use super::{Mode, RayCounts, SHADOW_EPSILON, Tracer};
+use crate::accel::TILE_RAYS;
+use crate::accel::tri4::Best8;
+use crate::geometry::{Ray, RayTile};
+use crate::scene::Indirect;
 
-/// One pixel being shaded: hit point, its error bound, the normal facing the ray, its index.
-pub(super) type At = (Vec3, Vec3, Vec3, usize);
+/// Most pixels in a tile.
+const N: usize = TILE_RAYS;
 
-/// What one light gives one pixel: its term and shadow ray, or nothing ([`Tracer::light_term`]).
-pub(super) type Term = Option<(Vec3, Option<Ray>)>;
+/// Up to eight lanes of `f32`: one vector on the widest lanes (width 1 uses the first).
+pub(crate) type Block = [f32; 8];
+
+/// `a[o..o + 8]`.
+#[inline(always)]
+fn block(a: &[f32], o: usize) -> &Block {
+    a[o..o + 8].try_into().expect("eight lanes")
+}
+
+/// The pixels of a tile gathered for the kernel, packed in order.
+#[derive(Clone, Debug)]
+pub(crate) struct Gathered {
+    /// Each pixel's index in the tile, and its triangle.
+    idx: [u32; N],
+    tri: [u32; N],
+    /// The hit's barycentrics (eight more, so that any pixel starts a [`Block`]).
+    b: [[f32; N + 8]; 3],
+}
+
+impl Default for Gathered {
+    fn default() -> Self {
+        Gathered {
+            idx: [0; N],
+            tri: [0; N],
+            b: [[0.0; N + 8]; 3],
+        }
+    }
+}
+
+/// Points being shaded, in `B` blocks of eight (pixel `i` in lane `i % 8` of block `i / 8`),
+/// each vector `[x, y, z]`.
+#[derive(Clone, Debug)]
+pub(crate) struct Points<const B: usize> {
+    /// The hit point, its error bound and the normal facing the ray ([`Surface`]).
+    p: [[Block; 3]; B],
+    err: [[Block; 3]; B],
+    normal: [[Block; 3]; B],
+    /// The sum over the lights so far.
+    sum: [[Block; 3]; B],
+    /// One light's term, and its shadow ray's origin and direction.
+    term: [[Block; 3]; B],
+    pub(super) origin: [[Block; 3]; B],
+    pub(super) dir: [[Block; 3]; B],
+}
+
+impl<const B: usize> Default for Points<B> {
+    fn default() -> Self {
+        let zero = [[[0.0; 8]; 3]; B];
+        Points {
+            p: zero,
+            err: zero,
+            normal: zero,
+            sum: zero,
+            term: zero,
+            origin: zero,
+            dir: zero,
+        }
+    }
+}
+
+impl<const B: usize> Points<B> {
+    /// One point, for one ray at a time.
+    fn one(at: &Surface<f32>) -> Points<B> {
+        let mut p = Points::default();
+        for k in 0..3 {
+            p.p[0][k][0] = at.p[k];
+            p.err[0][k][0] = at.err[k];
+            p.normal[0][k][0] = at.normal[k];
+        }
+        p
+    }
+
+    /// The [`Surface`] of the pixels from `o`.
+    #[inline(always)]
+    fn surface<S: Lanes>(&self, s: S, o: usize) -> Surface<S::F> {
+        let (c, at) = (o / 8, o % 8);
+        let (p, err, normal) = (&self.p[c], &self.err[c], &self.normal[c]);
+        Surface {
+            p: each3!(|k| s.load_at(&p[k], at)),
+            err: each3!(|k| s.load_at(&err[k], at)),
+            normal: each3!(|k| s.load_at(&normal[k], at)),
+        }
+    }
+
+    /// Pixel `i` of `v`.
+    #[inline(always)]
+    pub(super) fn at(v: &[[Block; 3]; B], i: usize) -> Vec3 {
+        let b = &v[i / 8];
+        Vec3::new(b[0][i % 8], b[1][i % 8], b[2][i % 8])
+    }
+}
+
+/// How a tile's shadow rays toward one light are traced.
+#[derive(Clone, Copy)]
+enum Shadows {
+    /// Through the scene's structure: one ray alone ([`crate::Scene::occluded`]), several
+    /// together ([`crate::Scene::occluded_each`]).
+    Scene,
+    /// In packets of eight against the light's cull ([`Tracer::culls`]: small scenes).
+    #[cfg(target_arch = "x86_64")]
+    Packets(super::lane::Avx2),
+}
+
+/// Scratch space of [`Shadows::Scene`] for a tile.
+#[derive(Clone, Debug, Default)]
+pub(super) struct ShadowScratch {
+    rays: Vec<Ray>,
+    blocked: Vec<bool>,
+}
 
 impl Tracer<'_> {
-    /// [`Tracer::light_term`] of `light` for every pixel of `at`, appended to `out` in order.
-    pub(super) fn light_terms(&self, light: &PointLight, at: &[At], out: &mut Vec<Term>) {
+    /// The tile kernel of [`Tracer::shade_tile_best`]: on the widest lanes the scene's path
+    /// has, the entry compiled for that path.
+    pub(super) fn shade_tile_in(
+        &self,
+        rays: &RayTile,
+        best: &[Best8; N / 8],
+        out: &mut [Vec3],
+        n: &mut RayCounts,
+        scratch: &mut super::TileScratch,
+    ) {
+        assert!(rays.len() <= N && out.len() == rays.len());
         #[cfg(target_arch = "x86_64")]
-        if light.power != Vec3::ZERO && matches!(self.scene.isa(), Isa::Avx2 | Isa::Avx512) {
-            for chunk in at.chunks(8) {
-                // SAFETY: the CPU has AVX2 (the scene's path is only set where it is available).
-                unsafe { self.light_terms8_avx2(light, chunk, out) };
+        if let Some(avx2) = super::lane::Avx2::of(self.scene.isa()) {
+            // SAFETY: the token says the CPU has AVX2; the scene's path is AVX-512 only where
+            // the CPU has it.
+            unsafe {
+                if self.scene.isa() == crate::simd::Isa::Avx512 {
+                    self.shade_tile_avx512(avx2, rays, best, out, n, scratch)
+                } else {
+                    self.shade_tile_avx2(avx2, rays, best, out, n, scratch)
+                }
             }
             return;
         }
-        out.extend(
-            at.iter()
-                .map(|&(p, err, normal, _)| self.light_term(light, p, err, normal)),
-        );
+        self.shade_lanes(Scalar, rays, best, out, n, scratch)
     }
 
-    /// Up to eight pixels of [`Tracer::light_terms`] (the light's power is not zero).
-    ///
-    /// # Safety
-    /// The CPU must have AVX2.
+    /// [`Tracer::shade_lanes`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn light_terms8_avx2(&self, light: &PointLight, at: &[At], out: &mut Vec<Term>) {
-        use std::arch::x86_64::*;
-        let n = at.len();
-        debug_assert!((1..=8).contains(&n));
-        // Lanes past the end repeat the last pixel (never used).
-        let mut soa = [[0f32; 8]; 9];
-        for l in 0..8 {
-            let (p, e, nn, _) = at[l.min(n - 1)];
-            for k in 0..3 {
-                soa[k][l] = p[k];
-                soa[3 + k][l] = e[k];
-                soa[6 + k][l] = nn[k];
-            }
-        }
-        // SAFETY: reads eight `f32`s.
-        let ld = |a: &[f32; 8]| unsafe { _mm256_loadu_ps(a.as_ptr()) };
-        let [px, py, pz, ex, ey, ez, nx, ny, nz] = soa.each_ref().map(ld);
-        let LightLanes {
-            term,
-            origin,
-            dir,
-            lit,
-            traced,
-        } = light_lanes_avx2(light, self.min_r2, [px, py, pz], [ex, ey, ez], [nx, ny, nz]);
-        let inv = dir.map(|d| _mm256_div_ps(_mm256_set1_ps(1.0), d));
-        let store = |v: __m256| {
-            let mut a = [0f32; 8];
-            // SAFETY: writes eight `f32`s.
-            unsafe { _mm256_storeu_ps(a.as_mut_ptr(), v) };
-            a
-        };
-        let (term, origin, dir, inv) = (
-            term.map(store),
-            origin.map(store),
-            dir.map(store),
-            inv.map(store),
-        );
-        let v = |a: &[[f32; 8]; 3], l: usize| Vec3::new(a[0][l], a[1][l], a[2][l]);
-        for l in 0..n {
-            out.push((lit & 1 << l != 0).then(|| {
-                let shadow = (self.settings.effects.shadows && traced & 1 << l != 0)
-                    .then(|| Ray::with_inverse(v(&origin, l), v(&dir, l), v(&inv, l)));
-                (v(&term, l), shadow)
-            }));
-        }
-    }
-}
-
-/// One light's arithmetic for eight pixels ([`light_lanes_avx2`]).
-#[cfg(target_arch = "x86_64")]
-pub(super) struct LightLanes {
-    /// The unshadowed term per channel.
-    pub term: [__m256; 3],
-    /// The shadow ray's origin (the offset hit point) and direction (to the light).
-    pub origin: [__m256; 3],
-    pub dir: [__m256; 3],
-    /// The lanes lit, and the lanes with a shadow ray to trace (a bit per lane).
-    pub lit: u32,
-    pub traced: u32,
-}
-
-/// [`Tracer::light_term`]'s arithmetic for eight pixels (hit point `p`, its error `err`, the
-/// normal `n` facing the ray, each as x, y, z lanes), the same `f32` operations in the same
-/// order; `min_r2` is the tracer's. Shared by the tile's two shading paths.
-#[cfg(target_arch = "x86_64")]
-#[inline]
-#[target_feature(enable = "avx2")]
-pub(super) fn light_lanes_avx2(
-    light: &PointLight,
-    min_r2: f32,
-    p: [__m256; 3],
-    err: [__m256; 3],
-    n: [__m256; 3],
-) -> LightLanes {
-    use std::arch::x86_64::*;
-    use std::f32::consts::PI;
-    let [px, py, pz] = p;
-    let [ex, ey, ez] = err;
-    let [nx, ny, nz] = n;
-    let sp = |v: f32| _mm256_set1_ps(v);
-    let (add, sub, mul, div) = (
-        |a, b| _mm256_add_ps(a, b),
-        |a, b| _mm256_sub_ps(a, b),
-        |a, b| _mm256_mul_ps(a, b),
-        |a, b| _mm256_div_ps(a, b),
-    );
-    let zero = _mm256_setzero_ps();
-    let sign = sp(-0.0);
-    let abs = |v| _mm256_andnot_ps(sign, v);
-    let lp = light.position;
-    // `to_light`, `length_squared`, `cos`, the term.
-    let (tx, ty, tz) = (sub(sp(lp.x), px), sub(sp(lp.y), py), sub(sp(lp.z), pz));
-    let dist2 = add(add(mul(tx, tx), mul(ty, ty)), mul(tz, tz));
-    let lit = _mm256_cmp_ps::<_CMP_GT_OQ>(dist2, zero);
-    let cos = div(
-        add(add(mul(nx, tx), mul(ny, ty)), mul(nz, tz)),
-        _mm256_sqrt_ps(dist2),
-    );
-    let lit = _mm256_and_ps(lit, _mm256_cmp_ps::<_CMP_GT_OQ>(cos, zero));
-    // `dist2.max(min_r2)`: dist2 > 0 where it matters, never NaN there.
-    let denom = mul(sp(4.0 * PI), _mm256_max_ps(dist2, sp(min_r2)));
-    let pw = light.power;
-    let mut term = [div(mul(sp(pw.x), cos), denom); 3];
-    // A white light's three terms are one value (the same operations on the same inputs).
-    if pw.y.to_bits() != pw.x.to_bits() || pw.z.to_bits() != pw.x.to_bits() {
-        term[1] = div(mul(sp(pw.y), cos), denom);
-        term[2] = div(mul(sp(pw.z), cos), denom);
-    }
-    // `offset_ray_origin(p, err, normal, to_light)`.
-    let d = add(add(mul(abs(nx), ex), mul(abs(ny), ey)), mul(abs(nz), ez));
-    let wn = add(add(mul(tx, nx), mul(ty, ny)), mul(tz, nz));
-    let flip = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(wn, zero), sign);
-    let inf = sp(f32::INFINITY);
-    let mut nonzero = zero;
-    let mut finite = _mm256_cmp_ps::<_CMP_EQ_OQ>(zero, zero);
-    let mut origin = [zero; 3];
-    let mut dir = [zero; 3];
-    for (k, (p, nk)) in [(px, nx), (py, ny), (pz, nz)].into_iter().enumerate() {
-        let offset = _mm256_xor_ps(mul(nk, d), flip);
-        origin[k] = offset_step_avx2(add(p, offset), offset);
-        dir[k] = sub(sp(lp[k]), origin[k]);
-        nonzero = _mm256_or_ps(nonzero, _mm256_cmp_ps::<_CMP_NEQ_UQ>(dir[k], zero));
-        finite = _mm256_and_ps(finite, _mm256_cmp_ps::<_CMP_LT_OQ>(abs(dir[k]), inf));
-    }
-    LightLanes {
-        term,
-        origin,
-        dir,
-        lit: _mm256_movemask_ps(lit) as u32,
-        traced: _mm256_movemask_ps(_mm256_and_ps(nonzero, finite)) as u32,
-    }
-}
-
-/// The last step of `offset_ray_origin` in eight lanes: each lane of `v` (the point plus its
-/// offset) moved one float up where `off` is positive and one float down where it is
-/// negative, as `next_float_up` and `next_float_down` do it (integer steps on the bits). Only
-/// callable from code compiled for AVX2, where it inlines.
-#[cfg(target_arch = "x86_64")]
-#[inline]
-#[target_feature(enable = "avx2")]
-fn offset_step_avx2(
-    v: std::arch::x86_64::__m256,
-    off: std::arch::x86_64::__m256,
-) -> std::arch::x86_64::__m256 {
-    use std::arch::x86_64::*;
-    let zero = _mm256_setzero_ps();
-    let sign = _mm256_set1_ps(-0.0);
-    let one = _mm256_set1_epi32(1);
-    let is_zero = _mm256_cmp_ps::<_CMP_EQ_OQ>(v, zero);
-    let nan = _mm256_cmp_ps::<_CMP_UNORD_Q>(v, v);
-    // `next_float_up`: ±0 → +0, then one step away from −∞; +∞ and NaN stay.
-    let u = _mm256_blendv_ps(v, zero, is_zero);
-    let ub = _mm256_castps_si256(u);
-    let up = _mm256_blendv_ps(
-        _mm256_castsi256_ps(_mm256_sub_epi32(ub, one)),
-        _mm256_castsi256_ps(_mm256_add_epi32(ub, one)),
-        _mm256_cmp_ps::<_CMP_GE_OQ>(u, zero),
-    );
-    let keep = _mm256_or_ps(
-        _mm256_cmp_ps::<_CMP_EQ_OQ>(v, _mm256_set1_ps(f32::INFINITY)),
-        nan,
-    );
-    let up = _mm256_blendv_ps(up, v, keep);
-    // `next_float_down`: ±0 → −0, then one step toward −∞; −∞ and NaN stay.
-    let w = _mm256_blendv_ps(v, sign, is_zero);
-    let wb = _mm256_castps_si256(w);
-    let down = _mm256_blendv_ps(
-        _mm256_castsi256_ps(_mm256_add_epi32(wb, one)),
-        _mm256_castsi256_ps(_mm256_sub_epi32(wb, one)),
-        _mm256_cmp_ps::<_CMP_GT_OQ>(w, zero),
-    );
-    let keep = _mm256_or_ps(
-        _mm256_cmp_ps::<_CMP_EQ_OQ>(v, _mm256_set1_ps(f32::NEG_INFINITY)),
-        nan,
-    );
-    let down = _mm256_blendv_ps(down, v, keep);
-    let v = _mm256_blendv_ps(v, down, _mm256_cmp_ps::<_CMP_LT_OQ>(off, zero));
-    _mm256_blendv_ps(v, up, _mm256_cmp_ps::<_CMP_GT_OQ>(off, zero))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::scene::cornell::cornell_box;
-    use crate::shading::Stage;
-
-    /// A small generator for the test (xorshift).
-    fn next(s: &mut u64) -> f32 {
-        *s ^= *s << 13;
-        *s ^= *s >> 7;
-        *s ^= *s << 17;
-        (*s >> 40) as f32 / (1u64 << 24) as f32
+    fn shade_tile_avx2(
+        &self,
+        s: super::lane::Avx2,
+        rays: &RayTile,
+        best: &[Best8; N / 8],
+        out: &mut [Vec3],
+        n: &mut RayCounts,
+        scratch: &mut super::TileScratch,
+    ) {
+        self.shade_lanes(s, rays, best, out, n, scratch)
     }
 
-    #[test]
-    fn eight_at_a_time_is_one_at_a_time_bit_for_bit() {
-        let scene = cornell_box();
-        let bits = |t: &Term| {
-            t.map(|(term, ray)| {
-                (
-                    term.to_array().map(f32::to_bits),
-                    ray.map(|r| {
-                        let v =
-                            [r.origin, r.dir, r.inv_dir].map(|v| v.to_array().map(f32::to_bits));
-                        (v, r.axes(), r.shear().map(f32::to_bits))
-                    }),
-                )
-            })
-        };
-        let mut s = 0x9E37_79B9_7F4A_7C15u64;
-        for case in 0..4000 {
-            let mut r = || next(&mut s) * 2.0 - 1.0;
-            let scale = [1e-6f32, 1.0, 1e4][case % 3];
-            let light = PointLight {
-                position: Vec3::new(r(), r(), r()) * scale,
-                power: Vec3::new(r().abs() * 20.0, 3.0, r().abs()),
+    /// [`Tracer::shade_lanes`] compiled for AVX-512: the same operations on eight lanes, with
+    /// 32 registers instead of 16 and comparisons into mask registers.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
+    fn shade_tile_avx512(
+        &self,
+        s: super::lane::Avx2,
+        rays: &RayTile,
+        best: &[Best8; N / 8],
+        out: &mut [Vec3],
+        n: &mut RayCounts,
+        scratch: &mut super::TileScratch,
+    ) {
+        self.shade_lanes(s, rays, best, out, n, scratch)
+    }
+
+    /// The kernel (see the module's doc), inlined into each entry.
+    #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // lanes, blocks and axes, in step across arrays
+    fn shade_lanes<S: Lanes>(
+        &self,
+        s: S,
+        rays: &RayTile,
+        best: &[Best8; N / 8],
+        out: &mut [Vec3],
+        n: &mut RayCounts,
+        scratch: &mut super::TileScratch,
+    ) {
+        let w = S::WIDTH;
+        let (g, pts) = (&mut scratch.gathered, &mut *scratch.points);
+        let k = rays.len();
+        debug_assert!(k <= N);
+        // The pixels shaded here, packed in order; the others one at a time.
+        let mut m = 0;
+        let mut others = 0u64;
+        // `in_lanes` of the last triangle asked (neighbours mostly hit the same one).
+        let mut last = (u32::MAX, false);
+        for c in 0..k.div_ceil(8) {
+            let (ids, bary) = (best[c].ids(), best[c].barycentrics());
+            let lanes = (k - 8 * c).min(8);
+            let own = if lanes == 8 && *ids == [ids[0]; 8] && ids[0] != u32::MAX {
+                // Eight hits on one triangle.
+                if ids[0] != last.0 {
+                    last = (ids[0], self.in_lanes(ids[0]));
+                }
+                if last.1 { 0xff } else { 0 }
+            } else {
+                let mut own = 0u32;
+                for (l, &id) in ids[..lanes].iter().enumerate() {
+                    if id != u32::MAX {
+                        if id != last.0 {
+                            last = (id, self.in_lanes(id));
+                        }
+                        own |= (last.1 as u32) << l;
+                    }
+                }
+                own
             };
-            let at: Vec<At> = (0..1 + case % 8)
-                .map(|i| {
-                    let mut p = Vec3::new(r(), r(), r()) * scale;
-                    // Edge cases: the light itself, signed zeros, no error.
-                    match (case + i) % 9 {
-                        0 => p = light.position,
-                        1 => p = Vec3::new(-0.0, 0.0, r()),
-                        _ => {}
+            // Eight pixels all shaded here (most packets): copied as they are.
+            if own == 0xff {
+                for (l, i) in g.idx[m..m + 8].iter_mut().enumerate() {
+                    *i = (8 * c + l) as u32;
+                }
+                g.tri[m..m + 8].copy_from_slice(ids);
+                for a in 0..3 {
+                    g.b[a][m..m + 8].copy_from_slice(&bary[a]);
+                }
+                m += 8;
+                continue;
+            }
+            for l in 0..lanes {
+                let i = 8 * c + l;
+                if ids[l] == u32::MAX {
+                    out[i] = Vec3::ZERO;
+                } else if own >> l & 1 == 0 {
+                    others |= 1 << i;
+                } else {
+                    // (`m < N`: the mask only tells the compiler so.)
+                    let j = m & (N - 1);
+                    g.idx[j] = i as u32;
+                    g.tri[j] = ids[l];
+                    for a in 0..3 {
+                        g.b[a][j] = bary[a][l];
                     }
-                    let err = if (case + i) % 7 == 0 {
-                        Vec3::ZERO
-                    } else {
-                        (Vec3::new(r(), r(), r()).abs() + Vec3::splat(0.1)) * 1e-6 * scale
-                    };
-                    let n = Vec3::new(r(), r(), r()).normalize_or(Vec3::Y);
-                    // A point the offset takes exactly to 0 in x (one of the two signs does).
-                    if (case + i) % 5 == 0 {
-                        let d = n.abs().dot(err);
-                        p.x = if i % 2 == 0 { n.x * d } else { -(n.x * d) };
-                    }
-                    (p, err, n, i)
-                })
-                .collect();
-            for shadows in [true, false] {
-                let mut settings = Stage::Indirect.settings(scene.effects());
-                settings.effects.shadows = shadows;
-                let lights = [light];
-                let tracer = Tracer::new(&scene, &lights, settings);
-                let mut got = vec![];
-                tracer.light_terms(&light, &at, &mut got);
-                assert_eq!(got.len(), at.len());
-                for (g, &(p, err, n, _)) in got.iter().zip(&at) {
-                    let want = tracer.light_term(&light, p, err, n);
-                    assert_eq!(
-                        bits(g),
-                        bits(&want),
-                        "case {case}: p {p} err {err} n {n} light {light:?}"
-                    );
+                    m += 1;
                 }
             }
         }
+        while others != 0 {
+            let i = others.trailing_zeros() as usize;
+            others &= others - 1;
+            let mut rng = crate::rng::Rng::seeded(0);
+            out[i] = self.shade_primary(&rays.ray(i), best[i / 8].hit(i % 8), &mut rng, n);
+        }
+        if m == 0 {
+            return;
+        }
+        let tris = self.scene.triangles();
+        let dirs = rays.dir_lanes();
+        let chunks = m.div_ceil(w);
+        // Bit `c`: the pixels of block `c` are all on one triangle (the common case): its
+        // values are splatted, else gathered lane by lane.
+        let mut same = 0u64;
+        for c in 0..chunks {
+            let o = c * w;
+            let count = (m - o).min(w);
+            let tri = g.tri[o];
+            let one = match count {
+                1 => true,
+                8 => g.tri[o..o + 8] == [tri; 8],
+                _ => g.tri[o..o + count].iter().all(|&t| t == tri),
+            };
+            same |= (one as u64) << c;
+        }
+        for c in 0..chunks {
+            let o = c * w;
+            let count = (m - o).min(w);
+            // Lanes past the last pixel repeat it.
+            let lane = |l: usize| o + l.min(count - 1);
+            let first = &tris[g.tri[o] as usize];
+            let same = same >> c & 1 == 1;
+            let tri = |l: usize| &tris[g.tri[lane(l)] as usize];
+            let v = each3!(|j| each3!(|a| match same {
+                true => s.splat(first.v[j][a]),
+                false => s.gather(|l| tri(l).v[j][a]),
+            }));
+            let normal = each3!(|a| match same {
+                true => s.splat(first.normal[a]),
+                false => s.gather(|l| tri(l).normal[a]),
+            });
+            // The rays' directions: the tile's own lanes when these pixels are the tile's
+            // pixels `o..` (indices only grow, so the last one tells), else gathered.
+            let in_place = g.idx[o + count - 1] as usize == o + count - 1 && o + 8 <= N;
+            let dir = each3!(|a| match in_place {
+                true => s.load(block(&dirs[a], o)),
+                false => s.gather(|l| dirs[a][g.idx[lane(l)] as usize]),
+            });
+            let b = each3!(|a| s.load(block(&g.b[a], o)));
+            let at = surface(s, v, normal, b, dir);
+            let (bi, ai) = (o / 8, o % 8);
+            let (p, err, nn) = (&mut pts.p[bi], &mut pts.err[bi], &mut pts.normal[bi]);
+            each3!(|a| {
+                s.store_at(&mut p[a], ai, at.p[a]);
+                s.store_at(&mut err[a], ai, at.err[a]);
+                s.store_at(&mut nn[a], ai, at.normal[a]);
+            });
+        }
+        let shadows = self.tile_shadows(s);
+        self.add_lights(s, pts, m, shadows, &mut scratch.shadows, n);
+        let indirect = match self.settings.effects.indirect {
+            Indirect::Constant(k) => k,
+            _ => 0.0,
+        };
+        let materials = self.scene.materials();
+        debug_assert!(m <= k);
+        for c in 0..chunks {
+            let o = c * w;
+            let count = (m - o).min(w);
+            let sum = &pts.sum[o / 8];
+            let sum = each3!(|a| s.load_at(&sum[a], o % 8));
+            let colour = match self.settings.mode {
+                Mode::Colour => {
+                    let same = same >> c & 1 == 1;
+                    let albedo = |l: usize| {
+                        let t = g.tri[o + l.min(count - 1)];
+                        materials[tris[t as usize].material as usize].colour
+                    };
+                    let rho = each3!(|a| match same {
+                        true => s.splat(albedo(0)[a]),
+                        false => s.gather(|l| albedo(l)[a]),
+                    });
+                    super::diffuse(s, rho, sum, [s.splat(indirect); 3])
+                }
+                _ => sum,
+            };
+            let mut rgb = [[0f32; 8]; 3];
+            each3!(|a| s.store(&mut rgb[a], colour[a]));
+            let colour = |l: usize| Vec3::new(rgb[0][l], rgb[1][l], rgb[2][l]);
+            if g.idx[o + count - 1] as usize == o + count - 1 {
+                // These pixels in place (indices only grow): written in a row.
+                for (l, out) in out[o..o + count].iter_mut().enumerate() {
+                    *out = colour(l);
+                }
+            } else {
+                for l in 0..count {
+                    out[g.idx[o + l] as usize] = colour(l);
+                }
+            }
+        }
+        debug_assert!(out.iter().all(|c| c.is_finite()), "non-finite colour");
+    }
+
+    /// How this tile's shadow rays are traced on lanes `s`.
+    #[inline(always)]
+    fn tile_shadows<S: Lanes>(&self, s: S) -> Shadows {
+        #[cfg(target_arch = "x86_64")]
+        if let (Some(avx2), Some(_)) = (s.avx2(), self.culls()) {
+            return Shadows::Packets(avx2);
+        }
+        let _ = s;
+        Shadows::Scene
+    }
+
+    /// Direct irradiance at one point, the kernel at width 1 (see [`Tracer::direct`]).
+    pub(super) fn direct_at(&self, at: &Surface<f32>, n: &mut RayCounts) -> Vec3 {
+        let mut pts = Points::<1>::one(at);
+        self.add_lights(
+            Scalar,
+            &mut pts,
+            1,
+            Shadows::Scene,
+            &mut ShadowScratch::default(),
+            n,
+        );
+        Points::at(&pts.sum, 0)
+    }
+
+    /// The sums over the lights at the first `m` points of `pts` (their surfaces computed):
+    /// light by light, each point's term where the light reaches it and no shadow ray is
+    /// blocked (the tile's shadow rays toward a light traced together, as `shadows` says).
+    #[inline(always)]
+    fn add_lights<S: Lanes, const B: usize>(
+        &self,
+        s: S,
+        pts: &mut Points<B>,
+        m: usize,
+        shadows: Shadows,
+        scratch: &mut ShadowScratch,
+        n: &mut RayCounts,
+    ) {
+        let w = S::WIDTH;
+        let chunks = m.div_ceil(w);
+        // The lanes of block `c` that hold a pixel.
+        let valid = |c: usize| (1u32 << (m - c * w).min(w)) - 1;
+        for sum in &mut pts.sum[..m.div_ceil(8)] {
+            *sum = [[0.0; 8]; 3];
+        }
+        for (li, light) in self.lights.iter().enumerate() {
+            // A dark light adds nothing and traces nothing.
+            if light.power == Vec3::ZERO {
+                continue;
+            }
+            let (mut lit, mut traced) = (0u64, 0u64);
+            for c in 0..chunks {
+                let o = c * w;
+                let at = pts.surface(s, o);
+                let inc = point_light(s, light, self.min_r2, &at, self.settings.effects.shadows);
+                let (bi, ai) = (o / 8, o % 8);
+                let (term, origin, dir) =
+                    (&mut pts.term[bi], &mut pts.origin[bi], &mut pts.dir[bi]);
+                each3!(|a| {
+                    s.store_at(&mut term[a], ai, inc.term[a]);
+                    s.store_at(&mut origin[a], ai, inc.origin[a]);
+                    s.store_at(&mut dir[a], ai, inc.dir[a]);
+                });
+                let on = inc.lit & valid(c);
+                lit |= (on as u64) << (c * w);
+                traced |= ((inc.traced & on) as u64) << (c * w);
+            }
+            let mut blocked = 0;
+            if self.settings.effects.shadows && traced != 0 {
+                n.shadow += traced.count_ones() as u64;
+                let t_max = 1.0 - SHADOW_EPSILON;
+                blocked = match shadows {
+                    Shadows::Scene => self.blocked(pts, traced, t_max, scratch),
+                    #[cfg(target_arch = "x86_64")]
+                    Shadows::Packets(avx2) => {
+                        let cull = &self.culls().expect("a small scene's culls")[li];
+                        super::packets::blocked(avx2, cull, pts, m, traced, t_max)
+                    }
+                };
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            let _ = li;
+            let add = lit & !blocked;
+            for c in 0..chunks {
+                let on = (add >> (c * w)) as u32 & valid(c);
+                if on == 0 {
+                    continue;
+                }
+                let on = s.lanes(on);
+                let (bi, ai) = (c * w / 8, c * w % 8);
+                let (sum, term) = (&mut pts.sum[bi], &pts.term[bi]);
+                each3!(|a| {
+                    let v = s.load_at(&sum[a], ai);
+                    let t = s.load_at(&term[a], ai);
+                    s.store_at(&mut sum[a], ai, s.select(on, s.add(v, t), v));
+                });
+            }
+        }
+    }
+
+    /// Which of the `traced` points' shadow rays (bit per point) are blocked before `t_max`,
+    /// through the scene's structure.
+    fn blocked<const B: usize>(
+        &self,
+        pts: &Points<B>,
+        traced: u64,
+        t_max: f32,
+        scratch: &mut ShadowScratch,
+    ) -> u64 {
+        let ray = |i: usize| Ray::new(Points::at(&pts.origin, i), Points::at(&pts.dir, i));
+        if traced.count_ones() == 1 {
+            let i = traced.trailing_zeros() as usize;
+            return (self.scene.occluded(&ray(i), t_max) as u64) << i;
+        }
+        let ShadowScratch { rays, blocked } = scratch;
+        rays.clear();
+        let mut left = traced;
+        while left != 0 {
+            rays.push(ray(left.trailing_zeros() as usize));
+            left &= left - 1;
+        }
+        blocked.clear();
+        blocked.resize(rays.len(), false);
+        self.scene.occluded_each(rays, t_max, blocked);
+        let (mut out, mut left) = (0, traced);
+        for &b in blocked.iter() {
+            let i = left.trailing_zeros();
+            left &= left - 1;
+            out |= (b as u64) << i;
+        }
+        out
     }
 }

@@ -32,50 +32,51 @@ pub struct ShadowRays8 {
 #[inline]
 pub unsafe fn any_hit8_avx2(v: &[[f32; 4]; 3], rays: &ShadowRays8, t_max: f32) -> (u32, u32) {
     // SAFETY: this function's contract.
-    unsafe { any_hit8_in::<0>(v, rays, t_max) }
+    unsafe { any_hit8(v, rays, t_max) }
 }
 
-/// [`any_hit8_avx2`] as a copy of its own for each `COPY` (one per compilation of the shading
-/// kernel that inlines it).
+/// [`any_hit8_avx2`] inlined into its caller (a kernel compiled for AVX2 or AVX-512).
 ///
 /// # Safety
 /// The CPU must have AVX2.
-#[target_feature(enable = "avx2")]
-#[inline]
-pub(crate) unsafe fn any_hit8_in<const COPY: u8>(
-    v: &[[f32; 4]; 3],
-    rays: &ShadowRays8,
-    t_max: f32,
-) -> (u32, u32) {
+#[inline(always)]
+pub(crate) unsafe fn any_hit8(v: &[[f32; 4]; 3], rays: &ShadowRays8, t_max: f32) -> (u32, u32) {
     use avx::*;
     use std::arch::x86_64::*;
-    // SAFETY: every load reads a whole 32-byte-aligned `[f32; 8]`.
-    let load = |p: &[f32; 8]| unsafe { _mm256_load_ps(p.as_ptr()) };
-    let [kx, ky, kz] = rays.axes;
-    let (ox, oy, oz) = (
-        load(&rays.origin[0]),
-        load(&rays.origin[1]),
-        load(&rays.origin[2]),
-    );
-    // `RayFrame`: each vertex relative to each lane's origin, in the axis order.
-    let rel = |p: &[f32; 4]| {
-        (
-            sub(splat(p[kx]), ox),
-            sub(splat(p[ky]), oy),
-            sub(splat(p[kz]), oz),
-        )
-    };
-    let ((a0, b0, z0), (a1, b1, z1), (a2, b2, z2)) = (rel(&v[0]), rel(&v[1]), rel(&v[2]));
-    let (sx, sy, sz) = (
-        load(&rays.shear[0]),
-        load(&rays.shear[1]),
-        load(&rays.shear[2]),
-    );
-    let (hit, redo, ..) = watertight_lanes!(
-        avx,
-        [a0, b0, z0, a1, b1, z1, a2, b2, z2],
-        [sx, sy, sz],
-        splat(t_max)
-    );
-    (hit, redo)
+    // SAFETY: the CPU has AVX2 (this function's contract); every load reads a whole
+    // 32-byte-aligned `[f32; 8]`.
+    // (No closures: this runs inlined into kernels compiled for AVX2 or AVX-512, and a
+    // closure would be compiled on its own, without those features.)
+    unsafe {
+        let [kx, ky, kz] = rays.axes;
+        let ox = _mm256_load_ps(rays.origin[0].as_ptr());
+        let oy = _mm256_load_ps(rays.origin[1].as_ptr());
+        let oz = _mm256_load_ps(rays.origin[2].as_ptr());
+        // `RayFrame`: each vertex relative to each lane's origin, in the axis order.
+        let (a0, b0, z0) = (
+            sub(splat(v[0][kx]), ox),
+            sub(splat(v[0][ky]), oy),
+            sub(splat(v[0][kz]), oz),
+        );
+        let (a1, b1, z1) = (
+            sub(splat(v[1][kx]), ox),
+            sub(splat(v[1][ky]), oy),
+            sub(splat(v[1][kz]), oz),
+        );
+        let (a2, b2, z2) = (
+            sub(splat(v[2][kx]), ox),
+            sub(splat(v[2][ky]), oy),
+            sub(splat(v[2][kz]), oz),
+        );
+        let sx = _mm256_load_ps(rays.shear[0].as_ptr());
+        let sy = _mm256_load_ps(rays.shear[1].as_ptr());
+        let sz = _mm256_load_ps(rays.shear[2].as_ptr());
+        let (hit, redo, ..) = watertight_lanes!(
+            avx,
+            [a0, b0, z0, a1, b1, z1, a2, b2, z2],
+            [sx, sy, sz],
+            splat(t_max)
+        );
+        (hit, redo)
+    }
 }

@@ -1,0 +1,233 @@
+//! What a light gives a surface, in lanes: one function per kind of light (today the point
+//! light), written once over [`Lanes`] so that one ray at a time is width 1.
+
+use std::f32::consts::PI;
+
+use super::lane::{Lanes, each3};
+use super::surface::{Surface, dot, offset_origin};
+use crate::scene::PointLight;
+
+/// One light's contribution at a [`Surface`]'s points, one per lane.
+pub(crate) struct Incident<F> {
+    /// What the light adds per channel if nothing blocks it.
+    pub term: [F; 3],
+    /// The shadow ray: its origin (the offset hit point) and direction (to the light).
+    pub origin: [F; 3],
+    pub dir: [F; 3],
+    /// The lanes the light reaches (bit per lane): it is not behind the surface or at the
+    /// point. A lane not lit adds nothing and costs no shadow ray.
+    pub lit: u32,
+    /// The lanes whose shadow ray can be traced (a direction neither zero nor infinite); a lit
+    /// lane without one counts as seen.
+    pub traced: u32,
+}
+
+/// A point light at the points of `at`: irradiance `P·max(r̂·n̂, 0)/(4πr²)`, with `r²`
+/// clamped to `min_r2` (the scene's minimum light distance, squared), and where `shadows`
+/// the shadow ray (else none is traced: `traced` is 0). The light's power is not zero (a
+/// dark light is skipped before).
+#[inline(always)]
+pub(crate) fn point_light<S: Lanes>(
+    s: S,
+    light: &PointLight,
+    min_r2: f32,
+    at: &Surface<S::F>,
+    shadows: bool,
+) -> Incident<S::F> {
+    let zero = s.splat(0.0);
+    let lp = light.position.to_array();
+    let to_light = each3!(|k| s.sub(s.splat(lp[k]), at.p[k]));
+    let dist2 = dot(s, to_light, to_light);
+    let cos = s.div(dot(s, at.normal, to_light), s.sqrt(dist2));
+    let lit = s.and(s.gt(dist2, zero), s.gt(cos, zero));
+    let lit_bits = s.bits(lit);
+    if lit_bits == 0 {
+        // Nothing to add, no ray to trace.
+        return Incident {
+            term: [zero; 3],
+            origin: [zero; 3],
+            dir: [zero; 3],
+            lit: 0,
+            traced: 0,
+        };
+    }
+    // `dist2` is positive where it matters, never NaN there.
+    let denom = s.mul(s.splat(4.0 * PI), s.max(dist2, s.splat(min_r2)));
+    let pw = light.power;
+    let mut term = [s.div(s.mul(s.splat(pw.x), cos), denom); 3];
+    // A white light's three terms are one value (the same operations on the same inputs).
+    if pw.y.to_bits() != pw.x.to_bits() || pw.z.to_bits() != pw.x.to_bits() {
+        term[1] = s.div(s.mul(s.splat(pw.y), cos), denom);
+        term[2] = s.div(s.mul(s.splat(pw.z), cos), denom);
+    }
+    if !shadows {
+        return Incident {
+            term,
+            origin: [zero; 3],
+            dir: [zero; 3],
+            lit: lit_bits,
+            traced: 0,
+        };
+    }
+    let origin = offset_origin(s, at, to_light);
+    let dir = each3!(|k| s.sub(s.splat(lp[k]), origin[k]));
+    let inf = s.splat(f32::INFINITY);
+    let nonzero = s.or(
+        s.or(s.ne(dir[0], zero), s.ne(dir[1], zero)),
+        s.ne(dir[2], zero),
+    );
+    let finite = each3!(|k| s.lt(s.abs(dir[k]), inf));
+    let finite = s.and(s.and(finite[0], finite[1]), finite[2]);
+    Incident {
+        term,
+        origin,
+        dir,
+        lit: lit_bits,
+        traced: s.bits(s.and(nonzero, finite)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::geometry::{hit_point, offset_ray_origin};
+    use crate::rng::Rng;
+    use crate::shading::lane::Scalar;
+    use crate::shading::surface::surface;
+
+    fn uniform(rng: &mut Rng) -> f32 {
+        (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+    }
+
+    fn vec(rng: &mut Rng) -> Vec3 {
+        Vec3::new(uniform(rng), uniform(rng), uniform(rng))
+    }
+
+    /// A point light's term and shadow ray at one point, `[term, origin, dir]` as bits, and
+    /// whether it is lit and traced.
+    type Bits = ([[u32; 3]; 3], bool, bool);
+
+    fn bits(i: &Incident<f32>) -> Bits {
+        let b = |v: [f32; 3]| v.map(f32::to_bits);
+        (
+            [b(i.term), b(i.origin), b(i.dir)],
+            i.lit != 0,
+            i.traced != 0,
+        )
+    }
+
+    /// Random triangles, hits, rays and lights at several scales, with the edge cases (the
+    /// light at the point, signed zeros, no error, an offset that lands on 0): width 1 is the
+    /// scalar formulas of `geometry` (`hit_point`, `offset_ray_origin`) bit for bit, and on
+    /// AVX2 eight lanes are eight times width 1.
+    #[test]
+    fn one_lane_is_the_scalar_formulas_and_eight_lanes_are_eight_of_one() {
+        let mut rng = Rng::seeded(5);
+        let mut lit = 0;
+        for case in 0..4000 {
+            let scale = [1e-6f32, 1.0, 1e4][case % 3];
+            let light = PointLight {
+                position: vec(&mut rng) * scale,
+                power: Vec3::new(uniform(&mut rng).abs() * 20.0, 3.0, uniform(&mut rng).abs()),
+            };
+            let white = PointLight {
+                power: Vec3::splat(5.0),
+                ..light
+            };
+            let mut points = vec![];
+            for i in 0..8 {
+                let v = [0; 3].map(|_| vec(&mut rng) * scale);
+                let normal = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or(Vec3::Y);
+                let (b1, b2) = (uniform(&mut rng).abs(), uniform(&mut rng).abs());
+                let b = [1.0 - b1 - b2 * (1.0 - b1), b1, b2 * (1.0 - b1)];
+                let dir = vec(&mut rng).normalize_or(Vec3::X);
+                let at = surface(
+                    Scalar,
+                    v.map(|v| v.to_array()),
+                    normal.to_array(),
+                    b,
+                    dir.to_array(),
+                );
+                let (p, err) = hit_point(&v, b);
+                assert_eq!(at.p.map(f32::to_bits), p.to_array().map(f32::to_bits));
+                assert_eq!(at.err.map(f32::to_bits), err.to_array().map(f32::to_bits));
+                let facing = if normal.dot(dir) > 0.0 {
+                    -normal
+                } else {
+                    normal
+                };
+                assert_eq!(
+                    at.normal.map(f32::to_bits),
+                    facing.to_array().map(f32::to_bits)
+                );
+                let mut at = at;
+                match (case + i) % 9 {
+                    0 => at.p = light.position.to_array(),
+                    1 => at.p = [-0.0, 0.0, at.p[2]],
+                    2 => at.err = [0.0; 3],
+                    3 => {
+                        // A point the offset takes exactly to 0 in x (one of the signs does).
+                        let n = Vec3::from_array(at.normal);
+                        let d = n.abs().dot(Vec3::from_array(at.err));
+                        at.p[0] = if i % 2 == 0 { n.x * d } else { -(n.x * d) };
+                    }
+                    _ => {}
+                }
+                let w = vec(&mut rng);
+                let o = offset_origin(Scalar, &at, w.to_array());
+                let want = offset_ray_origin(
+                    Vec3::from_array(at.p),
+                    Vec3::from_array(at.err),
+                    Vec3::from_array(at.normal),
+                    w,
+                );
+                assert_eq!(o.map(f32::to_bits), want.to_array().map(f32::to_bits));
+                points.push(at);
+            }
+            for light in [light, white] {
+                let one: Vec<Bits> = points
+                    .iter()
+                    .map(|at| bits(&point_light(Scalar, &light, 1e-4, at, true)))
+                    .collect();
+                lit += one.iter().filter(|b| b.1).count();
+                #[cfg(target_arch = "x86_64")]
+                if let Some(s) = crate::shading::lane::Avx2::of(crate::simd::Isa::Avx2) {
+                    let lanes = |f: fn(&Surface<f32>) -> [f32; 3]| {
+                        [0, 1, 2].map(|k| s.gather(|l| f(&points[l])[k]))
+                    };
+                    let at = Surface {
+                        p: lanes(|a| a.p),
+                        err: lanes(|a| a.err),
+                        normal: lanes(|a| a.normal),
+                    };
+                    let eight = point_light(s, &light, 1e-4, &at, true);
+                    let lane = |v: &[std::arch::x86_64::__m256; 3], l: usize| {
+                        v.map(|v| {
+                            let mut a = [0.0; 8];
+                            s.store(&mut a, v);
+                            a[l]
+                        })
+                    };
+                    for (l, want) in one.iter().enumerate() {
+                        let got = Incident {
+                            term: lane(&eight.term, l),
+                            origin: lane(&eight.origin, l),
+                            dir: lane(&eight.dir, l),
+                            lit: eight.lit >> l & 1,
+                            traced: eight.traced >> l & 1,
+                        };
+                        // Terms and rays of lanes not lit are not used: compare the rest.
+                        let got = bits(&got);
+                        assert_eq!(got.1, want.1, "case {case} lane {l}");
+                        if want.1 {
+                            assert_eq!((got.0, got.2), (want.0, want.2), "case {case} lane {l}");
+                        }
+                    }
+                }
+            }
+        }
+        assert!(lit > 10_000, "only {lit} points lit");
+    }
+}
