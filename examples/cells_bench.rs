@@ -16,7 +16,7 @@ use glam::Vec3;
 use raytty::bench::metrics::psnr8;
 use raytty::bench::timing::{Runs, measure, ms};
 use raytty::frame::{Cell, CellMode, Colour, encode_kitty, encode_sixel, paint};
-use raytty::{CellGrid, ColorMode, Image, cornell_box, encode_diff, encode_text, render};
+use raytty::{CellGrid, ColorMode, Image, Options, cornell_box, encode_diff, encode_text};
 
 /// CPU time of the calling thread: the machine this is measured on is shared, and a wall
 /// clock would count other programs' turns on the core.
@@ -45,8 +45,16 @@ fn main() {
     let scene = cornell_box();
     let mut settings = raytty::Stage::Indirect.settings(scene.effects());
     settings.effects.samples = SAMPLES;
-    let frame =
-        |w: u32, h: u32| render(&scene, &scene.camera(), scene.lights(), &settings, w, h).image;
+    let frame = |w: u32, h: u32| {
+        scene
+            .render(&Options {
+                width: w,
+                height: h,
+                settings: Some(settings),
+                ..Options::default()
+            })
+            .image
+    };
     let (full_w, full_h) = (cols * CELL.0, rows * CELL.1);
     let reference = frame(full_w, full_h);
     let runs = Runs {

@@ -14,20 +14,22 @@ use raytty::denoise::{GuidePixel, Guides};
 use raytty::scene::builtin;
 use raytty::shading::GI_MAX_BOUNCES;
 use raytty::shading::GuideHit;
-use raytty::{HitCache, Image, Scene, Settings, Stage, render_guided};
+use raytty::{HitCache, Image, Options, Output, Scene, Settings, Stage};
 
 fn guided(scene: &Scene, s: &Settings, w: u32, h: u32) -> Guides {
-    render_guided(
-        scene,
-        &scene.camera(),
-        scene.lights(),
-        s,
-        w,
-        h,
-        &mut HitCache::new(),
-    )
-    .guides
-    .unwrap()
+    HitCache::new()
+        .render(
+            scene,
+            &Options {
+                width: w,
+                height: h,
+                settings: Some(*s),
+                output: Output::Guides,
+                ..Options::default()
+            },
+        )
+        .guides
+        .unwrap()
 }
 
 /// Guides as raw little-endian floats (`GUIDES=DIR` caches them, so that changes to the

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use raytty::bench::metrics::rmse;
 use raytty::denoise::denoise;
-use raytty::{HitCache, Stage, cornell_box, render_guided};
+use raytty::{HitCache, Options, Output, Stage, cornell_box};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -33,14 +33,15 @@ fn main() {
         let mut out = None;
         for _ in 0..7 {
             let t = Instant::now();
-            let f = render_guided(
+            let f = HitCache::new().render(
                 &scene,
-                &scene.camera(),
-                scene.lights(),
-                &s,
-                w,
-                h,
-                &mut HitCache::new(),
+                &Options {
+                    width: w,
+                    height: h,
+                    settings: Some(s),
+                    output: Output::Guides,
+                    ..Options::default()
+                },
             );
             times.push(t.elapsed().as_secs_f64() * 1e3);
             let t = Instant::now();
@@ -84,17 +85,20 @@ fn light_move() {
         s
     };
     let guides = |lights: &[PointLight], frame| {
-        render_guided(
-            &scene,
-            &scene.camera(),
-            lights,
-            &gi(frame),
-            w,
-            h,
-            &mut HitCache::new(),
-        )
-        .guides
-        .unwrap()
+        HitCache::new()
+            .render(
+                &scene,
+                &Options {
+                    width: w,
+                    height: h,
+                    settings: Some(gi(frame)),
+                    lights: Some(lights),
+                    output: Output::Guides,
+                    ..Options::default()
+                },
+            )
+            .guides
+            .unwrap()
     };
     for steps in [1u32, 4] {
         let mut lights = scene.lights().to_vec();
@@ -119,7 +123,15 @@ fn light_move() {
         }
         let mut sum = vec![glam::DVec3::ZERO; (w * h) as usize];
         for f in 0..256 {
-            let img = raytty::render(&scene, &scene.camera(), &lights, &gi(1000 + f), w, h).image;
+            let img = scene
+                .render(&Options {
+                    width: w,
+                    height: h,
+                    settings: Some(gi(1000 + f)),
+                    lights: Some(&lights),
+                    ..Options::default()
+                })
+                .image;
             for (s, p) in sum.iter_mut().zip(&img.pixels) {
                 *s += p.as_dvec3();
             }
@@ -161,14 +173,15 @@ fn cpu_time() {
             let t = cpu_seconds();
             for f in 0..frames {
                 s.frame = f;
-                let fr = render_guided(
+                let fr = HitCache::new().render(
                     &scene,
-                    &scene.camera(),
-                    scene.lights(),
-                    &s,
-                    w,
-                    h,
-                    &mut HitCache::new(),
+                    &Options {
+                        width: w,
+                        height: h,
+                        settings: Some(s),
+                        output: Output::Guides,
+                        ..Options::default()
+                    },
                 );
                 if denoised {
                     std::hint::black_box(denoise(fr.guides.as_ref().unwrap()));

@@ -5,7 +5,7 @@
 use glam::Vec3;
 use raytty::denoise::denoise;
 use raytty::scene::builtin;
-use raytty::{HitCache, Image, Stage, render, render_guided};
+use raytty::{HitCache, Image, Options, Output, Stage};
 
 /// Each panel's size in pixels.
 const W: u32 = 240;
@@ -26,20 +26,28 @@ fn main() {
         .load()
         .expect("loads");
     let mut s = Stage::Gi.settings(scene.effects());
-    let f = render_guided(
+    let f = HitCache::new().render(
         &scene,
-        &scene.camera(),
-        scene.lights(),
-        &s,
-        W,
-        H,
-        &mut HitCache::new(),
+        &Options {
+            width: W,
+            height: H,
+            settings: Some(s),
+            output: Output::Guides,
+            ..Options::default()
+        },
     );
     let raw = f.image;
     let denoised = denoise(&f.guides.expect("GI guides")).image;
     s.effects.samples = ref_spp;
     s.frame = 0x2000_0000;
-    let reference = render(&scene, &scene.camera(), scene.lights(), &s, W, H).image;
+    let reference = scene
+        .render(&Options {
+            width: W,
+            height: H,
+            settings: Some(s),
+            ..Options::default()
+        })
+        .image;
     println!(
         "{name}: RMSE against the reference: raw {:.4}, denoised {:.4}",
         raytty::bench::metrics::rmse(&raw, &reference),

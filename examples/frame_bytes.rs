@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use raytty::frame::{Cell, Colour};
-use raytty::{CellGrid, ColorMode, HitCache, Stage, cornell_box, encode_diff, render_cached};
+use raytty::{CellGrid, ColorMode, HitCache, Options, Stage, cornell_box, encode_diff};
 
 const COLS: u32 = 200;
 const ROWS: u32 = 50;
@@ -59,7 +59,17 @@ fn main() {
                     camera.yaw += 5f32.to_radians();
                 }
             }
-            let frame = render_cached(&scene, &camera, &lights, &settings, w, h, &mut cache);
+            let frame = cache.render(
+                &scene,
+                &Options {
+                    width: w,
+                    height: h,
+                    settings: Some(settings),
+                    camera: Some(camera),
+                    lights: Some(&lights),
+                    ..Options::default()
+                },
+            );
             let start = Instant::now();
             let grid = CellGrid::from_image(&frame.image, ColorMode::TrueColor);
             let mut out = Vec::new();

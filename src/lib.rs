@@ -5,10 +5,9 @@
 //! [`CellGrid`] → bytes:
 //!
 //! ```
-//! use raytty::{cornell_box, render, CellGrid, ColorMode, Stage, encode_text};
+//! use raytty::{CellGrid, ColorMode, Options, cornell_box, encode_text};
 //! let scene = cornell_box();
-//! let settings = Stage::Indirect.settings(scene.effects());
-//! let frame = render(&scene, &scene.camera(), scene.lights(), &settings, 40, 24);
+//! let frame = scene.render(&Options { width: 40, height: 24, ..Options::default() });
 //! let text = encode_text(&CellGrid::from_image(&frame.image, ColorMode::Ascii));
 //! assert_eq!(text.iter().filter(|&&b| b == b'\n').count(), 12);
 //! ```
@@ -23,7 +22,7 @@ pub mod geometry;
 pub mod image;
 pub mod light;
 pub mod material;
-pub mod render;
+mod render;
 pub mod rng;
 pub mod sampler;
 pub mod scene;
@@ -36,7 +35,7 @@ pub use camera::Camera;
 pub use frame::{CellGrid, ColorMode, encode_diff, encode_text};
 pub use geometry::{Ray, Triangle};
 pub use image::Image;
-pub use render::{Frame, FrameStats, HitCache, render, render_cached, render_guided};
+pub use render::{BandDone, Frame, FrameStats, HitCache, Options, Output};
 pub use scene::cornell::cornell_box;
 pub use scene::{Effects, Indirect, Material, PointLight, Scene, SceneBuilder};
 pub use shading::{Mode, RayCounts, Settings, Stage, Tracer};

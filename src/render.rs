@@ -1,33 +1,107 @@
-//! The render loop: primary rays for every pixel, rows in parallel, shaded by [`Tracer`].
+//! The render: [`Scene::render`] turns a scene and its [`Options`] into a [`Frame`].
 //!
 //! A frame's pixels depend only on (scene, camera, lights, settings, size): each sample's random
 //! numbers are seeded from (pixel, sample, frame), and the ray counts are integer sums, so the
 //! image and the stats are the same with one thread or many.
+//!
+//! Three loops, by what a frame calls for: one sample per pixel (`bands.rs`: bands of rows in
+//! tiles of camera rays traced together), several samples of light that is not path traced
+//! (`samples.rs`: a pass of tiles per sample), and several path-traced samples (`paths.rs`: a
+//! row at a time, a pixel's samples one after the other).
 
-use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use rayon::prelude::*;
 
+mod bands;
+mod paths;
 mod samples;
 mod threads;
 
-use threads::{next_band, on_every_thread};
-
-use crate::accel::tri4::Best8;
-use crate::accel::{Hit, TILE_RAYS, TileCache};
-use crate::camera::Camera;
+use crate::accel::Hit;
+use crate::camera::{Camera, RayGen};
 use crate::denoise::{GuidePixel, Guides, denoise};
-use crate::geometry::RayTile;
+use crate::geometry::Ray;
 use crate::image::Image;
-use crate::rng::Rng;
 use crate::sampler::{Sampler, Stream};
 use crate::scene::{PointLight, Scene};
-use crate::shading::{RayCounts, Settings, TileScratch, Tracer};
+use crate::shading::{RayCounts, Settings, Stage, Tracer};
 
-/// The side of a tile of camera rays traced together (`TILE`² = [`TILE_RAYS`]).
+/// The side of a tile of camera rays traced together (`TILE`² = [`crate::accel::TILE_RAYS`]).
 const TILE: usize = 8;
+
+/// What to render: the frame's size, and what to take instead of the scene's own camera,
+/// lights and effects. `Options::default()` is a 0×0 frame of the scene as it is.
+///
+/// ```
+/// use raytty::{Options, Stage, cornell_box};
+/// let scene = cornell_box();
+/// let settings = Some(Stage::Shadows.settings(scene.effects()));
+/// let frame = scene.render(&Options { width: 64, height: 48, settings, ..Options::default() });
+/// assert_eq!((frame.image.width, frame.image.height), (64, 48));
+/// ```
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options<'a> {
+    /// The frame's width in pixels.
+    pub width: u32,
+    /// The frame's height in pixels.
+    pub height: u32,
+    /// What is computed: the shading mode, the effects (samples per pixel and their sampler
+    /// among them) and the frame number that seeds the random numbers. `None`: the default
+    /// stage ([`Stage::Indirect`]) of the scene's own effects.
+    pub settings: Option<Settings>,
+    /// Where the rays come from; `None`: the scene's camera.
+    pub camera: Option<Camera>,
+    /// The lights; `None`: the scene's.
+    pub lights: Option<&'a [PointLight]>,
+    /// What the frame gives besides its image.
+    pub output: Output<'a>,
+}
+
+/// What a render gives besides its image ([`Options::output`]).
+#[derive(Clone, Copy, Default)]
+pub enum Output<'a> {
+    /// The image.
+    #[default]
+    Image,
+    /// The image and, with path-traced indirect light, the denoiser's guide buffers
+    /// ([`Frame::guides`]). The image is the same as [`Output::Image`]'s.
+    Guides,
+    /// With path-traced indirect light the image denoised (the frame's time includes the
+    /// filter's); other frames as [`Output::Image`] gives them ([`Options::denoises`]).
+    Denoised,
+    /// Every band of finished rows handed to the function as soon as it is finished: on the
+    /// thread that finished it, in no set order, each row exactly once, all before the render
+    /// returns. A caller can write the frame out while the rest of it renders. A frame of one
+    /// sample is then never held whole (the returned frame's image is 0×0): each thread
+    /// renders a band into rows of its own and reuses them for its next band (a 500×500 frame
+    /// would otherwise be 3 MB of fresh memory for the kernel to zero, written out after it
+    /// has left the caches).
+    Rows(BandDone<'a>),
+}
+
+impl std::fmt::Debug for Output<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Output::Image => "Image",
+            Output::Guides => "Guides",
+            Output::Denoised => "Denoised",
+            Output::Rows(_) => "Rows(..)",
+        })
+    }
+}
+
+/// What [`Output::Rows`] hands each band of finished rows to: `(y0, pixels)`, the image's rows
+/// from `y0` down, `pixels.len()` a whole number of rows.
+pub type BandDone<'a> = &'a (dyn Fn(u32, &[Vec3]) + Sync);
+
+impl Options<'_> {
+    /// Whether [`Output::Denoised`] changes a frame of these options of `scene`: only
+    /// path-traced indirect light is denoised.
+    pub fn denoises(&self, scene: &Scene) -> bool {
+        Job::new(scene, self).tracer.splits()
+    }
+}
 
 /// What a frame cost.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -47,23 +121,25 @@ pub struct Frame {
     pub image: Image,
     /// What it cost.
     pub stats: FrameStats,
-    /// The denoiser's guide buffers: only from [`render_guided`] with path-traced indirect
+    /// The denoiser's guide buffers: only for [`Output::Guides`] with path-traced indirect
     /// light.
     pub guides: Option<Guides>,
 }
 
 /// The primary hits of the last frame, reused while the camera, size and geometry stay the
-/// same: a frame where only the light (or the stage) changed traces no primary ray.
+/// same: a frame where only the light (or the stage) changed traces no primary ray. Frames of
+/// one sample per pixel use it ([`HitCache::render`]); the others leave it as it is.
 #[derive(Clone, Debug, Default)]
 pub struct HitCache {
-    key: Option<(CameraKey, u32, u32)>,
+    key: Option<CacheKey>,
     hits: Vec<Option<Hit>>,
 }
 
-type CameraKey = [u32; 15];
+/// The camera ([`Camera::key`]) and the frame's size.
+type CacheKey = ([u32; 15], u32, u32);
 
-fn camera_key(c: &Camera) -> CameraKey {
-    c.key()
+fn cache_key(c: &Camera, width: u32, height: u32) -> CacheKey {
+    (c.key(), width, height)
 }
 
 impl HitCache {
@@ -77,406 +153,148 @@ impl HitCache {
         self.key = None;
         self.hits.clear();
     }
-}
 
-/// Renders a `width`×`height` frame.
-pub fn render(
-    scene: &Scene,
-    camera: &Camera,
-    lights: &[PointLight],
-    settings: &Settings,
-    width: u32,
-    height: u32,
-) -> Frame {
-    render_impl(
-        scene, camera, lights, settings, width, height, None, false, None,
-    )
-}
-
-/// What [`render_streamed`] hands each band of finished rows to: `(y0, pixels)`, the image's
-/// rows from `y0` down, `pixels.len()` a whole number of rows.
-pub type BandDone<'a> = &'a (dyn Fn(u32, &[Vec3]) + Sync);
-
-/// [`render`]'s frame, every row handed to `done` as soon as it is finished, a band of rows at
-/// a time: on the thread that finished them, in no set order, each row exactly once, all before
-/// this returns, which gives the frame's stats. A caller can write the frame out while the rest
-/// of it renders. A frame of one sample is never held whole: each thread renders a band into
-/// rows of its own and reuses them for its next band (a 500×500 frame would otherwise be 3 MB
-/// of fresh memory for the kernel to zero, written out after it has left the caches).
-pub fn render_streamed(
-    scene: &Scene,
-    camera: &Camera,
-    lights: &[PointLight],
-    settings: &Settings,
-    width: u32,
-    height: u32,
-    done: BandDone,
-) -> FrameStats {
-    render_impl(
-        scene,
-        camera,
-        lights,
-        settings,
-        width,
-        height,
-        None,
-        false,
-        Some(done),
-    )
-    .stats
-}
-
-/// Renders a frame, reusing `cache`'s primary hits when they are still valid (one sample per
-/// pixel, same camera and size) and refilling it otherwise.
-pub fn render_cached(
-    scene: &Scene,
-    camera: &Camera,
-    lights: &[PointLight],
-    settings: &Settings,
-    width: u32,
-    height: u32,
-    cache: &mut HitCache,
-) -> Frame {
-    render_impl(
-        scene,
-        camera,
-        lights,
-        settings,
-        width,
-        height,
-        Some(cache),
-        false,
-        None,
-    )
-}
-
-/// Whether [`render_denoised`] changes a frame of these settings: only path-traced indirect
-/// light is denoised (other frames come out as [`render`] gives them).
-pub fn denoises(scene: &Scene, lights: &[PointLight], settings: &Settings) -> bool {
-    Tracer::new(scene, lights, *settings).splits()
-}
-
-/// [`render_cached`], and with path-traced indirect light the denoiser's guide buffers too
-/// ([`Frame::guides`]). The image is the same as [`render_cached`]'s.
-pub fn render_guided(
-    scene: &Scene,
-    camera: &Camera,
-    lights: &[PointLight],
-    settings: &Settings,
-    width: u32,
-    height: u32,
-    cache: &mut HitCache,
-) -> Frame {
-    render_impl(
-        scene,
-        camera,
-        lights,
-        settings,
-        width,
-        height,
-        Some(cache),
-        true,
-        None,
-    )
-}
-
-/// One sample through `ray`. A path-traced frame's sample is split (the same colour either
-/// way, but one way of computing it, so that guided and plain frames agree bit for bit), and
-/// its parts are added to `guide` when the frame keeps guides.
-#[inline]
-fn sample(
-    tracer: &Tracer,
-    ray: &crate::geometry::Ray,
-    hit: Option<Hit>,
-    rng: &mut Stream,
-    n: &mut RayCounts,
-    guide: Option<&mut GuidePixel>,
-) -> Vec3 {
-    if !tracer.splits() {
-        return tracer.shade_primary(ray, hit, rng, n);
+    /// [`Scene::render`], reusing this cache's primary hits when they are still valid (one
+    /// sample per pixel, same camera and size) and refilling it otherwise. The frame is the
+    /// same either way.
+    pub fn render(&mut self, scene: &Scene, options: &Options) -> Frame {
+        render(scene, options, Some(self))
     }
-    let s = tracer.sample_primary(ray, hit, rng, n);
-    if let Some(g) = guide {
-        g.add(&s);
-    }
-    s.colour()
 }
 
-#[allow(clippy::too_many_arguments)]
-fn render_impl(
-    scene: &Scene,
-    camera: &Camera,
-    lights: &[PointLight],
-    settings: &Settings,
-    width: u32,
-    height: u32,
-    mut cache: Option<&mut HitCache>,
-    guided: bool,
-    done: Option<BandDone>,
-) -> Frame {
+impl Scene {
+    /// Renders a frame of this scene: see [`Options`] for what can be changed. Rendering
+    /// never fails: a scene that loaded is a valid one.
+    pub fn render(&self, options: &Options) -> Frame {
+        render(self, options, None)
+    }
+}
+
+/// One frame's inputs as the loops read them, shared by the render's threads.
+struct Job<'a> {
+    scene: &'a Scene,
+    tracer: Tracer<'a>,
+    camera: Camera,
+    rays: RayGen,
+    width: usize,
+    height: usize,
+    /// Samples per pixel (at least 1).
+    samples: u32,
+    /// Where a path-traced frame's numbers come from (independent ones for the others).
+    sampler: Sampler,
+    /// The frame number: seeds the random numbers.
+    frame: u32,
+    /// Where finished bands go ([`Output::Rows`]).
+    done: Option<BandDone<'a>>,
+}
+
+impl<'a> Job<'a> {
+    fn new(scene: &'a Scene, options: &Options<'a>) -> Job<'a> {
+        let settings = options
+            .settings
+            .unwrap_or_else(|| Stage::Indirect.settings(scene.effects()));
+        let camera = options.camera.unwrap_or_else(|| scene.camera());
+        let tracer = Tracer::new(scene, options.lights.unwrap_or(scene.lights()), settings);
+        // The sampler drives path-traced frames; the others keep their independent numbers.
+        let sampler = if tracer.splits() {
+            settings.effects.sampler
+        } else {
+            Sampler::Independent
+        };
+        Job {
+            scene,
+            tracer,
+            camera,
+            rays: camera.rays(options.width, options.height),
+            width: options.width as usize,
+            height: options.height as usize,
+            samples: settings.effects.samples.max(1),
+            sampler,
+            frame: settings.frame,
+            done: match options.output {
+                Output::Rows(done) => Some(done),
+                _ => None,
+            },
+        }
+    }
+
+    /// One sample through `ray`. A path-traced frame's sample is split (the same colour
+    /// either way, but one way of computing it, so that guided and plain frames agree bit for
+    /// bit), and its parts are added to `guide` when the frame keeps guides.
+    #[inline]
+    fn sample(
+        &self,
+        ray: &Ray,
+        hit: Option<Hit>,
+        rng: &mut Stream,
+        n: &mut RayCounts,
+        guide: Option<&mut GuidePixel>,
+    ) -> Vec3 {
+        if !self.tracer.splits() {
+            return self.tracer.shade_primary(ray, hit, rng, n);
+        }
+        let s = self.tracer.sample_primary(ray, hit, rng, n);
+        if let Some(g) = guide {
+            g.add(&s);
+        }
+        s.colour()
+    }
+}
+
+/// The one render: sets up the frame's image and guides, runs the loop the frame calls for,
+/// and denoises if asked to.
+fn render(scene: &Scene, options: &Options, cache: Option<&mut HitCache>) -> Frame {
     let start = Instant::now();
-    let samples = settings.effects.samples.max(1);
-    let tracer = Tracer::new(scene, lights, *settings);
-    // The sampler drives path-traced frames; the others keep their independent numbers.
-    let sampler = if tracer.splits() {
-        settings.effects.sampler
-    } else {
-        Sampler::Independent
-    };
-    let rays = camera.rays(width, height);
-    let (w, h) = (width as usize, height as usize);
-    // A streamed frame of one sample goes out band by band from each thread's own rows
-    // (`render_streamed`): it has no image, and its `Frame` (never returned) a 0×0 one.
-    let own_rows = done.is_some() && samples == 1;
+    let job = Job::new(scene, options);
+    let (width, height) = (options.width, options.height);
+    let (w, h) = (job.width, job.height);
+    // A streamed frame of one sample goes out band by band from each thread's own rows.
+    let own_rows = job.done.is_some() && job.samples == 1;
     let mut image = if own_rows {
         Image::new(0, 0)
     } else {
         Image::new(width, height)
     };
     // Path-traced frames split every sample for the denoiser (same colour, in any case).
-    let split = tracer.splits();
-    let draws = tracer.draws_random_numbers();
-    // Frames without path-traced light shade a tile at a time (the same colours), small
-    // scenes on AVX2 straight from the tile kernel's lanes.
-    let by_tile = tracer.shades_tiles();
-    let lanes = by_tile && tracer.shades_tile_lanes();
-    let mut guides = (guided && split).then(|| Guides {
+    let guided = matches!(options.output, Output::Guides | Output::Denoised);
+    let mut guides = (guided && job.tracer.splits()).then(|| Guides {
         width,
         height,
-        samples,
+        samples: job.samples,
         pixels: vec![GuidePixel::default(); w * h],
     });
-    if w == 0 || h == 0 {
-        return Frame {
-            image,
-            stats: FrameStats {
-                samples,
-                ..FrameStats::default()
-            },
-            guides,
-        };
-    }
-    // Rows of guide pixels, or none: zipped with the image's rows, `None` rows for none.
-    let mut guide_rows: Vec<Option<&mut [GuidePixel]>> = match guides.as_mut() {
-        Some(g) => g.pixels.chunks_mut(w).map(Some).collect(),
-        None => (0..h).map(|_| None).collect(),
-    };
-
-    let key = Some((camera_key(camera), width, height));
-    let counts = if samples == 1 {
-        let reuse = cache
-            .as_ref()
-            .is_some_and(|c| c.key == key && c.hits.len() == w * h);
-        // The cache's rows by band, or none (a frame whose hits nobody keeps stores none).
-        let mut hit_bands: Vec<Option<&mut [Option<Hit>]>> = match cache.as_mut() {
-            Some(c) => {
-                if !reuse {
-                    c.hits.resize(w * h, None);
-                }
-                c.hits.chunks_mut(TILE * w).map(Some).collect()
-            }
-            None => (0..h.div_ceil(TILE)).map(|_| None).collect(),
-        };
-        // Bands of `TILE` rows, walked in tiles of `TILE`×`TILE` pixels: each tile's camera
-        // rays are traced together (`Scene::intersect_tile`), then shaded. Every thread takes
-        // the next band until none is left, the calling thread too, from the top and the
-        // others from the bottom (`on_every_thread`).
-        // The image's rows by band, or none (each thread's own rows instead).
-        let mut pixel_bands: Vec<Option<&mut [Vec3]>> = if own_rows {
-            (0..h.div_ceil(TILE)).map(|_| None).collect()
-        } else {
-            image.pixels.chunks_mut(TILE * w).map(Some).collect()
-        };
-        let bands = Mutex::new(
-            pixel_bands
-                .iter_mut()
-                .zip(hit_bands.iter_mut())
-                .zip(guide_rows.chunks_mut(TILE))
-                .enumerate(),
-        );
-        let counts = on_every_thread(h.div_ceil(TILE), |from_back| {
-            let mut n = RayCounts::default();
-            let mut tile_rays = RayTile::default();
-            let mut tile_hits = [None; TILE_RAYS];
-            let mut tile_best = [Best8::NONE; TILE_RAYS / 8];
-            let mut tile_colours = [Vec3::ZERO; TILE_RAYS];
-            let mut scratch = TileScratch::default();
-            let mut tile_cache = TileCache::default();
-            let mut own = Vec::new();
-            loop {
-                let next = next_band(&bands, from_back);
-                let Some((band, ((pixels, hits), guide_rows))) = next else {
-                    return n;
-                };
-                let (y0, rows) = (band * TILE, guide_rows.len());
-                // Every pixel of a band is written below, so rows of this thread's own are
-                // reused as they are.
-                let pixels: &mut [Vec3] = match pixels {
-                    Some(p) => p,
-                    None => {
-                        own.resize(own.len().max(rows * w), Vec3::ZERO);
-                        &mut own[..rows * w]
-                    }
-                };
-                for x0 in (0..w).step_by(TILE) {
-                    let cols = (w - x0).min(TILE);
-                    // The tile's row `dy` (`cols` rays from `dy·cols`) in the band's rows.
-                    let row = |dy: usize| dy * w + x0..dy * w + x0 + cols;
-                    rays.tile(scene.isa(), x0, y0, cols, rows, &mut tile_rays);
-                    let k = tile_rays.len();
-                    let colours = &mut tile_colours[..k];
-                    if lanes {
-                        // The tile kernel's hits as it leaves them, in lanes, to shading.
-                        if !reuse {
-                            n.primary += k as u64;
-                            scene.intersect_tile_best(
-                                &tile_rays,
-                                f32::INFINITY,
-                                &mut tile_best,
-                                &mut tile_cache,
-                            );
-                        }
-                        if let Some(h) = hits.as_deref_mut() {
-                            for i in 0..k {
-                                let at = (i / cols) * w + x0 + i % cols;
-                                if reuse {
-                                    tile_best[i / 8].set(i % 8, h[at]);
-                                } else {
-                                    h[at] = tile_best[i / 8].hit(i % 8);
-                                }
-                            }
-                        }
-                        tracer.shade_tile_best(
-                            &tile_rays,
-                            &tile_best,
-                            colours,
-                            &mut n,
-                            &mut scratch,
-                        );
-                    } else {
-                        if !reuse {
-                            n.primary += k as u64;
-                            scene.intersect_tile(
-                                &tile_rays,
-                                f32::INFINITY,
-                                &mut tile_hits[..k],
-                                &mut tile_cache,
-                            );
-                        }
-                        if let Some(h) = hits.as_deref_mut() {
-                            for (dy, tile_row) in tile_hits[..k].chunks_exact_mut(cols).enumerate()
-                            {
-                                if reuse {
-                                    tile_row.copy_from_slice(&h[row(dy)]);
-                                } else {
-                                    h[row(dy)].copy_from_slice(tile_row);
-                                }
-                            }
-                        }
-                        if !by_tile {
-                            for (i, &hit) in tile_hits[..k].iter().enumerate() {
-                                let ray = &tile_rays.ray(i);
-                                let (dy, x) = (i / cols, x0 + i % cols);
-                                let y = y0 + dy;
-                                // Only path-traced light draws random numbers: skip the hash otherwise.
-                                let mut rng = if draws {
-                                    Stream::for_sample(
-                                        sampler,
-                                        (y * w + x) as u64,
-                                        0,
-                                        1,
-                                        settings.frame,
-                                    )
-                                } else {
-                                    Stream::Independent(Rng::seeded(0))
-                                };
-                                let g = guide_rows[dy].as_mut().map(|r| &mut r[x]);
-                                pixels[dy * w + x] = sample(&tracer, ray, hit, &mut rng, &mut n, g);
-                            }
-                            continue;
-                        }
-                        tracer.shade_tile(
-                            &tile_rays,
-                            &tile_hits[..k],
-                            colours,
-                            &mut n,
-                            &mut scratch,
-                        );
-                    }
-                    for (dy, tile_row) in colours.chunks_exact(cols).enumerate() {
-                        pixels[row(dy)].copy_from_slice(tile_row);
-                    }
-                }
-                if let Some(done) = done {
-                    done(y0 as u32, pixels);
-                }
-            }
-        });
-        drop((pixel_bands, hit_bands));
-        if let Some(c) = cache {
-            c.key = key;
-        }
-        counts
-    } else if by_tile {
-        // Several samples of light that is not path traced (anti-aliasing): a pass of tiles
-        // per sample.
-        samples::by_tile(
-            &mut image.pixels,
-            w,
-            samples,
-            settings.frame,
-            &rays,
-            scene,
-            &tracer,
-            done,
-        )
+    let rays = if w == 0 || h == 0 {
+        RayCounts::default()
     } else {
-        image
-            .pixels
-            .par_chunks_mut(w)
-            .zip(guide_rows.par_iter_mut())
-            .enumerate()
-            .map(|(y, (row, guide_row))| {
-                let mut n = RayCounts::default();
-                for (x, px) in row.iter_mut().enumerate() {
-                    let mut acc = Vec3::ZERO;
-                    for s in 0..samples {
-                        let pixel = (y * w + x) as u64;
-                        let mut rng =
-                            Stream::for_sample(sampler, pixel, s, samples, settings.frame);
-                        let (ox, oy) = samples::pixel_offset(&mut rng, s, samples);
-                        let ray = rays.ray(x as f32 + ox, y as f32 + oy);
-                        n.primary += 1;
-                        let hit = scene.intersect(&ray, f32::INFINITY);
-                        let g = guide_row.as_mut().map(|r| &mut r[x]);
-                        acc += sample(&tracer, &ray, hit, &mut rng, &mut n, g);
-                    }
-                    *px = acc / samples as f32;
-                    if let Some(r) = guide_row.as_mut() {
-                        r[x].scale(1.0 / samples as f32);
-                    }
-                }
-                if let Some(done) = done {
-                    done(y as u32, row);
-                }
-                n
-            })
-            .reduce(RayCounts::default, sum)
+        // Rows of guide pixels, or none: `None` rows for none.
+        let mut guide_rows: Vec<Option<&mut [GuidePixel]>> = match guides.as_mut() {
+            Some(g) => g.pixels.chunks_mut(w).map(Some).collect(),
+            None => (0..h).map(|_| None).collect(),
+        };
+        let pixels = (!own_rows).then_some(&mut image.pixels[..]);
+        if job.samples == 1 {
+            bands::render(&job, pixels, cache, &mut guide_rows)
+        } else if job.tracer.shades_tiles() {
+            samples::render(&job, &mut image.pixels)
+        } else {
+            paths::render(&job, &mut image.pixels, &mut guide_rows)
+        }
     };
-    Frame {
+    let mut frame = Frame {
         image,
         stats: FrameStats {
-            rays: counts,
-            samples,
+            rays,
+            samples: job.samples,
             elapsed: start.elapsed(),
         },
         guides,
+    };
+    if let (Output::Denoised, Some(g)) = (options.output, &frame.guides) {
+        let start = Instant::now();
+        frame.image = denoise(g).image;
+        frame.stats.elapsed += start.elapsed();
     }
-}
-
-fn sum(mut a: RayCounts, b: RayCounts) -> RayCounts {
-    a += b;
-    a
+    frame
 }
 
 impl FrameStats {
@@ -521,26 +339,4 @@ impl FrameStats {
             rayon::current_num_threads()
         )
     }
-}
-
-/// Renders a frame and, if its indirect light is path traced, denoises it: the frame's image
-/// is the denoised one and its time includes the filter's. Other frames are as
-/// [`render`] gives them.
-pub fn render_denoised(
-    scene: &Scene,
-    camera: &Camera,
-    lights: &[PointLight],
-    settings: &Settings,
-    width: u32,
-    height: u32,
-) -> Frame {
-    let mut frame = render_impl(
-        scene, camera, lights, settings, width, height, None, true, None,
-    );
-    if let Some(g) = &frame.guides {
-        let start = Instant::now();
-        frame.image = denoise(g).image;
-        frame.stats.elapsed += start.elapsed();
-    }
-    frame
 }

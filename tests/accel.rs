@@ -14,8 +14,8 @@ use raytty::accel::bvh::{Bvh, MAX_DEPTH};
 use raytty::geometry::intersect_watertight;
 use raytty::scene::procedural::displaced_icosphere;
 use raytty::{
-    AccelKind, Camera, Effects, Hit, Material, PointLight, Ray, Scene, SceneBuilder, Stage,
-    Triangle, cornell_box, render,
+    AccelKind, Camera, Effects, Hit, Material, Options, PointLight, Ray, Scene, SceneBuilder,
+    Stage, Triangle, cornell_box,
 };
 
 /// The answer by definition: the smallest `t`, ties to the lowest index.
@@ -228,7 +228,12 @@ fn huge_and_tiny_coordinates() {
 
 fn frame_bytes(scene: &Scene, stage: Stage, w: u32, h: u32) -> (Vec<u8>, raytty::RayCounts) {
     let settings = stage.settings(scene.effects());
-    let f = render(scene, &scene.camera(), scene.lights(), &settings, w, h);
+    let f = scene.render(&Options {
+        width: w,
+        height: h,
+        settings: Some(settings),
+        ..Options::default()
+    });
     let bytes = f
         .image
         .pixels

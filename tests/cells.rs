@@ -6,7 +6,7 @@
 use std::collections::HashMap;
 
 use raytty::frame::{CellMode, cell_pixels, encode_diff};
-use raytty::{CellGrid, ColorMode, Image, Stage, cornell_box, encode_text, render};
+use raytty::{CellGrid, ColorMode, Image, Options, Stage, cornell_box, encode_text};
 
 /// Rows of the grid every mode's pixels fall on (2, 3 and 4 divide it); two columns.
 const ROWS: usize = 12;
@@ -217,7 +217,15 @@ fn frame(w: u32, h: u32, light_dx: f32) -> Image {
     settings.effects.samples = 2;
     let mut lights = scene.lights().to_vec();
     lights[0].position.x += light_dx;
-    render(&scene, &scene.camera(), &lights, &settings, w, h).image
+    scene
+        .render(&Options {
+            width: w,
+            height: h,
+            settings: Some(settings),
+            lights: Some(&lights),
+            ..Options::default()
+        })
+        .image
 }
 
 fn sq(a: [u8; 3], b: [f64; 3]) -> f64 {

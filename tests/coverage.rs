@@ -2,7 +2,7 @@
 //! opening (which exactly fills the frame from the seed's camera) hits geometry: no background
 //! pixel leaks through a crease between floor, walls and ceiling.
 
-use raytty::{Stage, cornell_box, render};
+use raytty::{Options, Stage, cornell_box};
 
 #[test]
 fn every_pixel_of_the_seed_view_hits_the_box() {
@@ -12,7 +12,12 @@ fn every_pixel_of_the_seed_view_hits_the_box() {
         if stage == Stage::Gi {
             settings.effects.samples = 1;
         }
-        let frame = render(&scene, &scene.camera(), scene.lights(), &settings, 500, 500);
+        let frame = scene.render(&Options {
+            width: 500,
+            height: 500,
+            settings: Some(settings),
+            ..Options::default()
+        });
         assert_eq!(frame.stats.rays.primary, 250_000);
         for (i, p) in frame.image.pixels.iter().enumerate() {
             assert!(p.is_finite(), "{stage:?}: pixel {i} is {p}");
@@ -38,7 +43,12 @@ fn other_frame_shapes_see_the_whole_opening_too() {
     let scene = cornell_box();
     let settings = Stage::Flat.settings(scene.effects());
     for (w, h) in [(200, 100), (100, 200), (81, 47)] {
-        let frame = render(&scene, &scene.camera(), scene.lights(), &settings, w, h);
+        let frame = scene.render(&Options {
+            width: w,
+            height: h,
+            settings: Some(settings),
+            ..Options::default()
+        });
         let (cx, cy) = (w / 2, h / 2);
         let r = w.min(h) / 2 - 1;
         for y in cy - r..cy + r {

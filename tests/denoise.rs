@@ -12,7 +12,7 @@ use raytty::rng::Rng;
 use raytty::scene::builtin;
 use raytty::shading::GI_MAX_BOUNCES;
 use raytty::{
-    HitCache, Image, RayCounts, Scene, Settings, Stage, Tracer, cornell_box, render, render_guided,
+    HitCache, Image, Options, Output, RayCounts, Scene, Settings, Stage, Tracer, cornell_box,
 };
 
 fn gi(spp: u32, frame: u32) -> Settings {
@@ -24,14 +24,15 @@ fn gi(spp: u32, frame: u32) -> Settings {
 }
 
 fn guided(scene: &Scene, settings: &Settings, w: u32, h: u32) -> (Image, Guides) {
-    let f = render_guided(
+    let f = HitCache::new().render(
         scene,
-        &scene.camera(),
-        scene.lights(),
-        settings,
-        w,
-        h,
-        &mut HitCache::new(),
+        &Options {
+            width: w,
+            height: h,
+            settings: Some(*settings),
+            output: Output::Guides,
+            ..Options::default()
+        },
     );
     (f.image, f.guides.expect("a GI frame has guides"))
 }
@@ -56,7 +57,14 @@ fn gi_of(scene: &Scene, spp: u32, frame: u32) -> Settings {
 /// from theirs, so its noise is independent).
 fn reference_of(scene: &Scene, w: u32, h: u32, spp: u32) -> Image {
     let s = gi_of(scene, spp, 1 << 20);
-    render(scene, &scene.camera(), scene.lights(), &s, w, h).image
+    scene
+        .render(&Options {
+            width: w,
+            height: h,
+            settings: Some(s),
+            ..Options::default()
+        })
+        .image
 }
 
 /// Raw and denoised stage 6 at `spp`.
@@ -121,7 +129,14 @@ fn the_denoised_frame_converges_to_the_raw_one_on_every_scene() {
 fn mean_of_frames(scene: &Scene, w: u32, h: u32, first: u32, frames: u32) -> Image {
     let mut sum = vec![DVec3::ZERO; (w * h) as usize];
     for f in first..first + frames {
-        let img = render(scene, &scene.camera(), scene.lights(), &gi(1, f), w, h).image;
+        let img = scene
+            .render(&Options {
+                width: w,
+                height: h,
+                settings: Some(gi(1, f)),
+                ..Options::default()
+            })
+            .image;
         for (s, p) in sum.iter_mut().zip(&img.pixels) {
             *s += p.as_dvec3();
         }
@@ -141,7 +156,14 @@ fn guided_frames_are_the_plain_frames() {
     let scene = cornell_box();
     for spp in [1, 4] {
         let (img, g) = guided(&scene, &gi(spp, 3), 40, 30);
-        let plain = render(&scene, &scene.camera(), scene.lights(), &gi(spp, 3), 40, 30).image;
+        let plain = scene
+            .render(&Options {
+                width: 40,
+                height: 30,
+                settings: Some(gi(spp, 3)),
+                ..Options::default()
+            })
+            .image;
         assert_eq!(img, plain, "{spp} spp");
         assert_eq!(g.samples, spp);
         // The guides add up to the same image (up to the rounding of a mean of parts).
@@ -299,7 +321,13 @@ fn the_raw_path_is_unbiased() {
     let raw = mean_of_frames(&scene, w, h, 0, frames);
     // The direct part, exact at pixel centres: what is left is the indirect light alone.
     let shadows = Stage::Shadows.settings(scene.effects());
-    let direct = render(&scene, &scene.camera(), scene.lights(), &shadows, w, h)
+    let direct = scene
+        .render(&Options {
+            width: w,
+            height: h,
+            settings: Some(shadows),
+            ..Options::default()
+        })
         .image
         .pixels
         .iter()

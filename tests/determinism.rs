@@ -5,8 +5,7 @@ use std::process::Command;
 
 use std::sync::Mutex;
 
-use raytty::render::render_streamed;
-use raytty::{Effects, Indirect, Stage, cornell_box, render};
+use raytty::{Effects, Indirect, Options, Output, Stage, cornell_box};
 
 fn image_bytes(threads: usize, stage: Stage, samples: u32) -> Vec<u8> {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -17,7 +16,12 @@ fn image_bytes(threads: usize, stage: Stage, samples: u32) -> Vec<u8> {
         let scene = cornell_box();
         let mut settings = stage.settings(scene.effects());
         settings.effects.samples = samples;
-        let f = render(&scene, &scene.camera(), scene.lights(), &settings, 64, 48);
+        let f = scene.render(&Options {
+            width: 64,
+            height: 48,
+            settings: Some(settings),
+            ..Options::default()
+        });
         float_bytes(&f.image)
     })
 }
@@ -64,13 +68,20 @@ fn path_traced_frames_are_deterministic_across_threads() {
                     samples: 2,
                     ..Effects::SEED
                 };
-                render(&scene, &scene.camera(), scene.lights(), &s, 40, 30).image
+                scene
+                    .render(&Options {
+                        width: 40,
+                        height: 30,
+                        settings: Some(s),
+                        ..Options::default()
+                    })
+                    .image
             })
     };
     assert_eq!(run(1), run(2));
 }
 
-/// `render_streamed` hands over every row of `render`'s frame exactly once, and counts its rays:
+/// `Output::Rows` hands over every row of the plain frame exactly once, and counts its rays:
 /// on 1 and 2 threads, one sample (bands of tiles, in each thread's own rows) and several
 /// (rows), at a size whose last band and last tile column are partial, and with more bands than
 /// threads (a thread's rows are reused).
@@ -91,16 +102,21 @@ fn streamed_bands_hold_every_row_once_as_the_frame_has_it() {
                     let done = |y0: u32, rows: &[glam::Vec3]| {
                         bands.lock().unwrap().push((y0, rows.to_vec()))
                     };
-                    let streamed = render_streamed(
-                        &scene,
-                        &scene.camera(),
-                        scene.lights(),
-                        &settings,
-                        w,
-                        h,
-                        &done,
-                    );
-                    let plain = render(&scene, &scene.camera(), scene.lights(), &settings, w, h);
+                    let streamed = scene
+                        .render(&Options {
+                            width: w,
+                            height: h,
+                            settings: Some(settings),
+                            output: Output::Rows(&done),
+                            ..Options::default()
+                        })
+                        .stats;
+                    let plain = scene.render(&Options {
+                        width: w,
+                        height: h,
+                        settings: Some(settings),
+                        ..Options::default()
+                    });
                     (streamed, plain)
                 });
             let what = format!("{threads} threads, {stage:?}, {samples} spp");
@@ -170,7 +186,13 @@ fn frames_are_bit_identical_to_the_committed_fingerprints() {
         .map(|stage| {
             let mut settings = stage.settings(scene.effects());
             settings.effects.samples = 4;
-            let f = render(&scene, &camera, scene.lights(), &settings, 48, 32);
+            let f = scene.render(&Options {
+                width: 48,
+                height: 32,
+                settings: Some(settings),
+                camera: Some(camera),
+                ..Options::default()
+            });
             (stage, fingerprint(&float_bytes(&f.image)))
         })
         .collect();
@@ -189,6 +211,12 @@ fn the_independent_sampler_renders_as_before_sobol() {
     let mut settings = Stage::Gi.settings(scene.effects());
     settings.effects.samples = 4;
     settings.effects.sampler = raytty::sampler::Sampler::Independent;
-    let f = render(&scene, &camera, scene.lights(), &settings, 48, 32);
+    let f = scene.render(&Options {
+        width: 48,
+        height: 32,
+        settings: Some(settings),
+        camera: Some(camera),
+        ..Options::default()
+    });
     assert_eq!(fingerprint(&float_bytes(&f.image)), 1583959633513374627);
 }

@@ -3,8 +3,8 @@
 
 use glam::Vec3;
 use raytty::{
-    Camera, Effects, FrameStats, HitCache, Image, Indirect, Material, PointLight, Scene,
-    SceneBuilder, Settings, Stage, cornell_box, render, render_cached,
+    Camera, Effects, FrameStats, HitCache, Image, Indirect, Material, Options, PointLight, Scene,
+    SceneBuilder, Settings, Stage, cornell_box,
 };
 
 const W: u32 = 48;
@@ -22,7 +22,14 @@ fn settings(shadows: bool, indirect: Indirect, samples: u32) -> Settings {
 }
 
 fn stats(scene: &Scene, s: &Settings) -> FrameStats {
-    render(scene, &scene.camera(), scene.lights(), s, W, H).stats
+    scene
+        .render(&Options {
+            width: W,
+            height: H,
+            settings: Some(*s),
+            ..Options::default()
+        })
+        .stats
 }
 
 const GI4: Indirect = Indirect::PathTraced { bounces: 4 };
@@ -89,15 +96,15 @@ fn a_light_behind_every_visible_surface_costs_no_shadow_ray() {
     // The control: the light moved in front of the wall casts shadow rays from every pixel.
     let mut front = wall.lights().to_vec();
     front[0].position.z = 0.0;
-    let s = render(
-        &wall,
-        &wall.camera(),
-        &front,
-        &settings(true, Indirect::Constant(0.5), 1),
-        W,
-        H,
-    )
-    .stats;
+    let s = wall
+        .render(&Options {
+            width: W,
+            height: H,
+            settings: Some(settings(true, Indirect::Constant(0.5), 1)),
+            lights: Some(&front),
+            ..Options::default()
+        })
+        .stats;
     assert_eq!(s.rays.shadow, u64::from(W * H));
 }
 
@@ -108,23 +115,38 @@ fn a_light_only_change_traces_no_primary_ray() {
     let s = scene.effects();
     for stage in [Stage::Shadows, Stage::Indirect, Stage::Gi] {
         let settings = stage.settings(s);
-        let first = render_cached(
+        let first = cache.render(
             &scene,
-            &scene.camera(),
-            scene.lights(),
-            &settings,
-            W,
-            H,
-            &mut cache,
+            &Options {
+                width: W,
+                height: H,
+                settings: Some(settings),
+                ..Options::default()
+            },
         );
         assert_eq!(first.stats.rays.primary, u64::from(W * H), "{stage:?}");
         let mut moved = scene.lights().to_vec();
         moved[0].position += Vec3::new(0.2, 0.1, -0.1);
-        let second = render_cached(&scene, &scene.camera(), &moved, &settings, W, H, &mut cache);
+        let second = cache.render(
+            &scene,
+            &Options {
+                width: W,
+                height: H,
+                settings: Some(settings),
+                lights: Some(&moved),
+                ..Options::default()
+            },
+        );
         assert_eq!(second.stats.rays.primary, 0, "{stage:?}");
         assert!(second.stats.rays.shadow > 0, "{stage:?}");
         // Reusing the hits changes no pixel.
-        let fresh = render(&scene, &scene.camera(), &moved, &settings, W, H);
+        let fresh = scene.render(&Options {
+            width: W,
+            height: H,
+            settings: Some(settings),
+            lights: Some(&moved),
+            ..Options::default()
+        });
         assert_eq!(second.image, fresh.image, "{stage:?}");
         cache.clear();
     }
@@ -204,14 +226,12 @@ fn gi_with_b_bounces_traces_at_most_b_bounce_rays_per_path() {
     }
     // One bounce: every primary hit sends exactly one bounce ray (nothing ends a path before
     // its first bounce) and a miss sends none. The flat stage shows which pixels hit.
-    let flat = render(
-        &scene,
-        &scene.camera(),
-        scene.lights(),
-        &Stage::Flat.settings(scene.effects()),
-        W,
-        H,
-    );
+    let flat = scene.render(&Options {
+        width: W,
+        height: H,
+        settings: Some(Stage::Flat.settings(scene.effects())),
+        ..Options::default()
+    });
     let hits = flat
         .image
         .pixels
@@ -250,19 +270,25 @@ fn mean(img: &Image) -> Vec3 {
 #[test]
 fn gi_is_direct_light_plus_something() {
     let scene = cornell_box();
-    let direct = render(
-        &scene,
-        &scene.camera(),
-        scene.lights(),
-        &settings(true, Indirect::None, 1),
-        W,
-        H,
-    )
-    .image;
+    let direct = scene
+        .render(&Options {
+            width: W,
+            height: H,
+            settings: Some(settings(true, Indirect::None, 1)),
+            ..Options::default()
+        })
+        .image;
     let gi_frame = |samples, frame| {
         let mut s = settings(true, Indirect::PathTraced { bounces: 8 }, samples);
         s.frame = frame;
-        render(&scene, &scene.camera(), scene.lights(), &s, W, H).image
+        scene
+            .render(&Options {
+                width: W,
+                height: H,
+                settings: Some(s),
+                ..Options::default()
+            })
+            .image
     };
     let gi = |samples| gi_frame(samples, 0);
     let gi1 = gi(1);
@@ -275,15 +301,14 @@ fn gi_is_direct_light_plus_something() {
         "GI adds only {added1}"
     );
     let added1 = (0..16).map(|f| mean(&gi_frame(1, f))).sum::<Vec3>() / 16.0 - mean(&direct);
-    let direct16 = render(
-        &scene,
-        &scene.camera(),
-        scene.lights(),
-        &settings(true, Indirect::None, 16),
-        W,
-        H,
-    )
-    .image;
+    let direct16 = scene
+        .render(&Options {
+            width: W,
+            height: H,
+            settings: Some(settings(true, Indirect::None, 16)),
+            ..Options::default()
+        })
+        .image;
     let added16 = mean(&gi(16)) - mean(&direct16);
     let rel = (added16 - added1).abs() / added16;
     assert!(
@@ -301,14 +326,12 @@ fn gi_is_the_same_with_one_thread_and_two() {
             .build()
             .expect("a thread pool")
             .install(|| {
-                render(
-                    &scene,
-                    &scene.camera(),
-                    scene.lights(),
-                    &settings(true, Indirect::PathTraced { bounces: 8 }, 4),
-                    W,
-                    H,
-                )
+                scene.render(&Options {
+                    width: W,
+                    height: H,
+                    settings: Some(settings(true, Indirect::PathTraced { bounces: 8 }, 4)),
+                    ..Options::default()
+                })
             })
     };
     let (one, two) = (run(1), run(2));
@@ -375,14 +398,12 @@ fn a_perfect_mirror_or_a_black_surface_traces_no_shadow_or_bounce_ray() {
     }
     // What the mirror shows is unchanged: the reflected rays leave the scene, so it is black.
     let wall = wall_of(mirror(1.0));
-    let f = render(
-        &wall,
-        &wall.camera(),
-        wall.lights(),
-        &settings(true, GI4, 1),
-        W,
-        H,
-    );
+    let f = wall.render(&Options {
+        width: W,
+        height: H,
+        settings: Some(settings(true, GI4, 1)),
+        ..Options::default()
+    });
     assert!(f.image.pixels.iter().all(|p| *p == Vec3::ZERO));
 }
 
@@ -398,7 +419,15 @@ fn a_dark_light_costs_no_shadow_ray() {
     };
     for stage in Stage::ALL {
         let s = stage.settings(scene.effects());
-        let frame = |lights: &[PointLight]| render(&scene, &scene.camera(), lights, &s, W, H);
+        let frame = |lights: &[PointLight]| {
+            scene.render(&Options {
+                width: W,
+                height: H,
+                settings: Some(s),
+                lights: Some(lights),
+                ..Options::default()
+            })
+        };
         let alone = frame(&[dark]);
         assert_eq!(alone.stats.rays.shadow, 0, "{stage:?}");
         assert_eq!(alone.image, frame(&[]).image, "{stage:?}");

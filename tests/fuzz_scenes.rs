@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 use raytty::rng::Rng;
 use raytty::scene::builtin::BUILTINS;
 use raytty::scene::file::{self, SceneFileError};
-use raytty::{Stage, render};
+use raytty::{Options, Stage};
 
 /// Largest mutated input: far above the seed files, small enough that every input is quick.
 const MAX_INPUT: usize = 64 * 1024;
@@ -185,7 +185,12 @@ fn check(scene: &str, mesh: &[u8], tally: &mut Tally) {
             // A scene that loaded renders a finite frame (samples capped to keep it quick).
             let mut settings = Stage::Indirect.settings(s.effects());
             settings.effects.samples = settings.effects.samples.min(2);
-            let frame = render(s, &s.camera(), s.lights(), &settings, 6, 4);
+            let frame = s.render(&Options {
+                width: 6,
+                height: 4,
+                settings: Some(settings),
+                ..Options::default()
+            });
             assert!(frame.image.pixels.iter().all(|p| p.is_finite()));
         }
         result
@@ -572,7 +577,12 @@ mod models {
             if let Ok(l) = &loaded {
                 let s = &l.scene;
                 let settings = Stage::Indirect.settings(s.effects());
-                let frame = render(s, &s.camera(), s.lights(), &settings, 6, 4);
+                let frame = s.render(&Options {
+                    width: 6,
+                    height: 4,
+                    settings: Some(settings),
+                    ..Options::default()
+                });
                 assert!(frame.image.pixels.iter().all(|p| p.is_finite()));
             }
             loaded

@@ -5,12 +5,18 @@
 use std::process::Command;
 
 use raytty::frame::{encode_kitty, encode_sixel};
-use raytty::{Stage, cornell_box, render};
+use raytty::{Options, Stage, cornell_box};
 
 fn frame(w: u32, h: u32) -> Vec<[u8; 3]> {
     let scene = cornell_box();
     let settings = Stage::Indirect.settings(scene.effects());
-    render(&scene, &scene.camera(), scene.lights(), &settings, w, h)
+    scene
+        .render(&Options {
+            width: w,
+            height: h,
+            settings: Some(settings),
+            ..Options::default()
+        })
         .image
         .to_rgb8()
 }

@@ -3,7 +3,7 @@
 
 use raytty::bench::metrics::rmse;
 use raytty::sampler::Sampler;
-use raytty::{Image, Stage, cornell_box, render};
+use raytty::{Image, Options, Stage, cornell_box};
 
 const W: u32 = 32;
 const H: u32 = 24;
@@ -15,7 +15,14 @@ fn gi(sampler: Sampler, samples: u32, frame: u32) -> Image {
     s.effects.samples = samples;
     s.effects.sampler = sampler;
     s.frame = frame;
-    render(&scene, &scene.camera(), scene.lights(), &s, W, H).image
+    scene
+        .render(&Options {
+            width: W,
+            height: H,
+            settings: Some(s),
+            ..Options::default()
+        })
+        .image
 }
 
 /// At 16 and 64 samples the Sobol frame is closer to a 2048-sample reference (independent

@@ -3,7 +3,7 @@
 
 use raytty::scene::builtin::{self, BUILTINS};
 use raytty::scene::file;
-use raytty::{FrameStats, Scene, Stage, render};
+use raytty::{FrameStats, Options, Scene, Stage};
 
 fn load(name: &str) -> Scene {
     builtin::find(name).unwrap().load().unwrap()
@@ -12,7 +12,15 @@ fn load(name: &str) -> Scene {
 /// The stats of one frame at the scene's own effects (the default stage).
 fn stats(scene: &Scene, lights: &[raytty::PointLight]) -> FrameStats {
     let settings = Stage::Indirect.settings(scene.effects());
-    render(scene, &scene.camera(), lights, &settings, 64, 48).stats
+    scene
+        .render(&Options {
+            width: 64,
+            height: 48,
+            settings: Some(settings),
+            lights: Some(lights),
+            ..Options::default()
+        })
+        .stats
 }
 
 #[test]

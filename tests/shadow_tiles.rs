@@ -12,7 +12,7 @@ use raytty::accel::Isa;
 use raytty::geometry::intersect_watertight;
 use raytty::scene::builtin;
 use raytty::{
-    Camera, Material, PointLight, Ray, Scene, SceneBuilder, Stage, Triangle, cornell_box, render,
+    Camera, Material, Options, PointLight, Ray, Scene, SceneBuilder, Stage, Triangle, cornell_box,
 };
 
 /// The frame's pixels as bits, and its ray counts.
@@ -23,7 +23,14 @@ fn frame(
     stage: Stage,
 ) -> (Vec<u32>, String) {
     let settings = stage.settings(scene.effects());
-    let f = render(scene, camera, lights, &settings, 61, 45);
+    let f = scene.render(&Options {
+        width: 61,
+        height: 45,
+        settings: Some(settings),
+        camera: Some(*camera),
+        lights: Some(lights),
+        ..Options::default()
+    });
     let bits = f
         .image
         .pixels

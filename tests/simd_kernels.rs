@@ -18,8 +18,8 @@ use raytty::accel::{Isa, TILE_RAYS, TileCache};
 use raytty::geometry::{Aabb, RayTile, TriHit, intersect_watertight};
 use raytty::scene::procedural::displaced_icosphere;
 use raytty::{
-    AccelKind, Camera, Effects, Hit, Material, PointLight, Ray, Scene, SceneBuilder, Stage,
-    cornell_box, render,
+    AccelKind, Camera, Effects, Hit, Material, Options, PointLight, Ray, Scene, SceneBuilder,
+    Stage, cornell_box,
 };
 
 /// The paths this CPU runs (always the portable one and, on x86-64, SSE2).
@@ -524,7 +524,12 @@ fn cornell_frames_are_identical_on_every_path() {
         let mut settings = stage.settings(scene.effects());
         settings.effects.samples = samples;
         let frame = |s: &Scene| {
-            let f = render(s, &s.camera(), s.lights(), &settings, 101, 61);
+            let f = s.render(&Options {
+                width: 101,
+                height: 61,
+                settings: Some(settings),
+                ..Options::default()
+            });
             let bits: Vec<u32> = f
                 .image
                 .pixels

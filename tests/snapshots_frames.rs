@@ -1,12 +1,17 @@
 //! 80×24 frames of each of the seed's stages, as ASCII and as truecolor ANSI, snapshotted with
 //! insta. In the ANSI snapshots ESC is written as `␛` so the files read as text.
 
-use raytty::{CellGrid, ColorMode, Stage, cornell_box, encode_text, render};
+use raytty::{CellGrid, ColorMode, Options, Stage, cornell_box, encode_text};
 
 fn frame(stage: Stage, mode: ColorMode) -> String {
     let scene = cornell_box();
     let settings = stage.settings(scene.effects());
-    let f = render(&scene, &scene.camera(), scene.lights(), &settings, 80, 48);
+    let f = scene.render(&Options {
+        width: 80,
+        height: 48,
+        settings: Some(settings),
+        ..Options::default()
+    });
     String::from_utf8(encode_text(&CellGrid::from_image(&f.image, mode))).unwrap()
 }
 

@@ -5,7 +5,7 @@
 use std::f32::consts::FRAC_PI_2;
 
 use glam::Vec3;
-use raytty::{Camera, Stage, cornell_box, render};
+use raytty::{Camera, Options, Stage, cornell_box};
 
 /// Frame size (even, so the centre row and column of rays are exactly axis-parallel).
 const SIZE: (u32, u32) = (64, 48);
@@ -69,7 +69,13 @@ fn awkward_cameras_give_finite_images_in_every_stage() {
     for (name, camera) in cameras(centre) {
         for stage in Stage::ALL {
             let settings = stage.settings(scene.effects());
-            let frame = render(&scene, &camera, scene.lights(), &settings, SIZE.0, SIZE.1);
+            let frame = scene.render(&Options {
+                width: SIZE.0,
+                height: SIZE.1,
+                settings: Some(settings),
+                camera: Some(camera),
+                ..Options::default()
+            });
             if let Some(k) = frame
                 .image
                 .pixels
@@ -105,7 +111,13 @@ fn a_camera_inside_a_closed_object_sees_only_its_inside() {
         ..Camera::default()
     };
     let settings = Stage::Flat.settings(scene.effects());
-    let frame = render(&scene, &camera, scene.lights(), &settings, SIZE.0, SIZE.1);
+    let frame = scene.render(&Options {
+        width: SIZE.0,
+        height: SIZE.1,
+        settings: Some(settings),
+        camera: Some(camera),
+        ..Options::default()
+    });
     let background = frame
         .image
         .pixels

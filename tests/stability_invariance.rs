@@ -10,7 +10,7 @@ mod common;
 use common::EDGE_TOL;
 use common::reference::Reference;
 use glam::Vec3;
-use raytty::{Camera, PointLight, Scene, SceneBuilder, Stage, cornell_box, render};
+use raytty::{Camera, Options, PointLight, Scene, SceneBuilder, Stage, cornell_box};
 
 const SIZE: (u32, u32) = (200, 100);
 
@@ -60,7 +60,15 @@ fn moved(base: &Scene, s: f32, offset: Vec3) -> (Scene, Camera, Vec<PointLight>)
 
 fn image(scene: &Scene, camera: &Camera, lights: &[PointLight]) -> Vec<[u8; 3]> {
     let settings = Stage::Indirect.settings(scene.effects());
-    render(scene, camera, lights, &settings, SIZE.0, SIZE.1)
+    scene
+        .render(&Options {
+            width: SIZE.0,
+            height: SIZE.1,
+            settings: Some(settings),
+            camera: Some(*camera),
+            lights: Some(lights),
+            ..Options::default()
+        })
         .image
         .to_rgb8()
 }

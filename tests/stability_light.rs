@@ -14,7 +14,7 @@ use glam::Vec3;
 use raytty::geometry::hit_point;
 use raytty::rng::Rng;
 use raytty::shading::RayCounts;
-use raytty::{PointLight, Ray, Scene, Stage, Tracer, cornell_box, render};
+use raytty::{Options, PointLight, Ray, Scene, Stage, Tracer, cornell_box};
 
 /// Frame size for the awkward-light renders (small: these check finiteness, not looks).
 const SIZE: (u32, u32) = (96, 72);
@@ -67,7 +67,13 @@ fn awkward_lights_give_finite_pixels_within_the_cap() {
         let cap = cap(&scene, &lights[0]);
         for stage in LIT {
             let settings = stage.settings(scene.effects());
-            let frame = render(&scene, &scene.camera(), &lights, &settings, SIZE.0, SIZE.1);
+            let frame = scene.render(&Options {
+                width: SIZE.0,
+                height: SIZE.1,
+                settings: Some(settings),
+                lights: Some(&lights),
+                ..Options::default()
+            });
             for (k, p) in frame.image.pixels.iter().enumerate() {
                 let (x, y) = (k as u32 % SIZE.0, k as u32 / SIZE.0);
                 assert!(

@@ -8,7 +8,7 @@ mod common;
 use common::EDGE_TOL;
 use common::reference::Reference;
 use glam::DVec3;
-use raytty::{Indirect, Stage, cornell_box, render};
+use raytty::{Indirect, Options, Stage, cornell_box};
 
 /// One 8-bit level of a linear channel.
 const LEVEL: f64 = 1.0 / 255.0;
@@ -21,7 +21,12 @@ fn indirect_frame_matches_the_f64_reference_within_one_level() {
     let Indirect::Constant(ambient) = settings.effects.indirect else {
         panic!("the Cornell box's indirect stage is the seed's constant term");
     };
-    let frame = render(&scene, &scene.camera(), scene.lights(), &settings, w, h);
+    let frame = scene.render(&Options {
+        width: w,
+        height: h,
+        settings: Some(settings),
+        ..Options::default()
+    });
     let reference = Reference::new(&scene);
     let rays = scene.camera().rays(w, h);
     let pixels = reference.frame(

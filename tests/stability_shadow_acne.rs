@@ -10,7 +10,7 @@ use common::reference::Reference;
 use common::{EDGE_TOL, Rng, case, in_cube, log_uniform, unit};
 use glam::Vec3;
 use raytty::geometry::{hit_point, offset_ray_origin};
-use raytty::{Ray, Stage, Triangle, cornell_box, render};
+use raytty::{Options, Ray, Stage, Triangle, cornell_box};
 
 /// Random triangles in the reintersection test, as in pbrt-v4.
 const TRIANGLES: u64 = 1000;
@@ -23,7 +23,12 @@ fn default_view_has_no_pixel_wrongly_in_shadow_or_wrongly_lit() {
     let scene = cornell_box();
     let (w, h) = (500, 500);
     let settings = Stage::Shadows.settings(scene.effects());
-    let frame = render(&scene, &scene.camera(), scene.lights(), &settings, w, h);
+    let frame = scene.render(&Options {
+        width: w,
+        height: h,
+        settings: Some(settings),
+        ..Options::default()
+    });
     let reference = Reference::new(&scene);
     let rays = scene.camera().rays(w, h);
     let pixels = reference.frame(&rays, (w, h), scene.lights(), true, 0.0, EDGE_TOL);

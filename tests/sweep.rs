@@ -2,7 +2,7 @@
 //! among them: every image is finite, every 8-bit pixel in range, and nothing panics.
 
 use glam::Vec3;
-use raytty::{Camera, PointLight, Stage, cornell_box, render, rng::Rng};
+use raytty::{Camera, Options, PointLight, Stage, cornell_box, rng::Rng};
 
 /// Poses in the sweep (the issue asks for at least 1000).
 const POSES: u32 = 1200;
@@ -70,7 +70,14 @@ fn random_poses_give_finite_in_range_images() {
         };
         let stage = Stage::ALL[(i % 6) as usize];
         let settings = stage.settings(scene.effects());
-        let frame = render(&scene, &camera, &[light], &settings, 32, 24);
+        let frame = scene.render(&Options {
+            width: 32,
+            height: 24,
+            settings: Some(settings),
+            camera: Some(camera),
+            lights: Some(&[light]),
+            ..Options::default()
+        });
         for (p, px) in frame.image.pixels.iter().enumerate() {
             assert!(
                 px.is_finite() && px.min_element() >= 0.0,

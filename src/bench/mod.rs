@@ -24,8 +24,7 @@ use std::time::Duration;
 
 use crate::frame::{CellGrid, ColorMode, encode_text};
 use crate::image::Image;
-use crate::render::render;
-use crate::render::render_denoised;
+use crate::render::{Options, Output};
 use crate::sampler::Sampler;
 use crate::scene::{Effects, Indirect, Scene};
 use crate::shading::{GI_MAX_BOUNCES, Mode, RayCounts, Settings, Stage};
@@ -372,17 +371,18 @@ fn measure(
 ) -> Row {
     let settings = kind.settings(scene);
     let denoised = matches!(kind, RowKind::Denoised { .. });
-    let render_once = || {
-        let draw = if denoised { render_denoised } else { render };
-        draw(
-            scene,
-            &scene.camera(),
-            scene.lights(),
-            &settings,
-            width,
-            height,
-        )
+    let frame_options = Options {
+        width,
+        height,
+        settings: Some(settings),
+        output: if denoised {
+            Output::Denoised
+        } else {
+            Output::Image
+        },
+        ..Options::default()
     };
+    let render_once = || scene.render(&frame_options);
     let runs = Runs {
         min: options.runs.max(1),
         min_total: options.min_row_time,

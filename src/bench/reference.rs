@@ -11,7 +11,7 @@ use glam::Vec3;
 use super::progress::Progress;
 
 use crate::image::Image;
-use crate::render::render;
+use crate::render::Options;
 use crate::sampler::Sampler;
 use crate::scene::{Effects, Indirect, Scene};
 use crate::shading::{Mode, Settings};
@@ -260,14 +260,12 @@ pub fn load_or_render(
     let start = Instant::now();
     let mut mean = Image::new(spec.width, spec.height);
     for pass in done..passes {
-        let frame = render(
-            scene,
-            &scene.camera(),
-            scene.lights(),
-            &spec.settings(pass),
-            spec.width,
-            spec.height,
-        );
+        let frame = scene.render(&Options {
+            width: spec.width,
+            height: spec.height,
+            settings: Some(spec.settings(pass)),
+            ..Options::default()
+        });
         for (s, p) in sum.iter_mut().zip(&frame.image.pixels) {
             *s += *p;
         }

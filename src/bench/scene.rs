@@ -10,7 +10,7 @@ use std::time::Duration;
 use super::table::{Align, Table};
 use super::timing::{self, Runs, ms};
 use crate::accel::AccelStats;
-use crate::render::render;
+use crate::render::Options;
 use crate::scene::Scene;
 use crate::shading::Stage;
 
@@ -67,16 +67,13 @@ pub fn bench_scene(scene: &Scene, sizes: &[(u32, u32)], runs: u32) -> SceneBench
     let sizes = sizes
         .iter()
         .map(|&(width, height)| {
-            let frame = || {
-                render(
-                    scene,
-                    &scene.camera(),
-                    scene.lights(),
-                    &settings,
-                    width,
-                    height,
-                )
+            let options = Options {
+                width,
+                height,
+                settings: Some(settings),
+                ..Options::default()
             };
+            let frame = || scene.render(&options);
             let rays = frame().stats.rays.total();
             let timing = timing::measure(
                 Runs {

@@ -9,8 +9,7 @@ use clap::ValueEnum;
 use glam::Vec3;
 use raytty::frame::{CellMode, encode_kitty, encode_sixel};
 use raytty::image::{pfm_band_offset, pfm_header, write_pfm_rows};
-use raytty::render::{denoises, render_denoised, render_streamed};
-use raytty::{CellGrid, ColorMode, PointLight, Scene, encode_text, render};
+use raytty::{CellGrid, ColorMode, Options, Output, PointLight, Scene, encode_text};
 
 use raytty::image::MAX_PIXELS;
 
@@ -158,7 +157,15 @@ pub(super) fn run_render(
         Some(f) => Box::new(BufWriter::new(f)),
         None => Box::new(BufWriter::new(io::stdout().lock())),
     };
-    let denoised = args.denoise == Switch::On && denoises(&scene, &lights, &settings);
+    let options = Options {
+        width: w,
+        height: h,
+        settings: Some(settings),
+        camera: Some(camera),
+        lights: Some(&lights),
+        ..Options::default()
+    };
+    let denoised = args.denoise == Switch::On && options.denoises(&scene);
     // A PFM file that is not denoised afterwards is written band by band as the render
     // finishes them, on the render's threads: the write overlaps the rest of the render.
     let streamed = match &file {
@@ -170,17 +177,18 @@ pub(super) fn run_render(
     let (stats, written) = match streamed {
         // Written as it renders: the frame is never held whole.
         Some(bands) => {
-            let stats = render_streamed(&scene, &camera, &lights, &settings, w, h, &|y0, rows| {
-                bands.write(y0, rows)
-            });
+            let write = |y0, rows: &[Vec3]| bands.write(y0, rows);
+            let output = Output::Rows(&write);
+            let stats = scene.render(&Options { output, ..options }).stats;
             (stats, bands.finish())
         }
         _ => {
-            let frame = if denoised {
-                render_denoised(&scene, &camera, &lights, &settings, w, h)
+            let output = if denoised {
+                Output::Denoised
             } else {
-                render(&scene, &camera, &lights, &settings, w, h)
+                Output::Image
             };
+            let frame = scene.render(&Options { output, ..options });
             let tone = args.tonemap.unwrap_or(scene.tone_map());
             let written = match format {
                 Format::Png => tone.image(&frame.image).write_png(&mut out),
@@ -250,7 +258,7 @@ fn cannot_write(args: &RenderArgs) -> String {
 }
 
 /// A PFM file written a band of rows at a time, in any order, as the render hands them over
-/// ([`render_streamed`]): each band goes to its own place (rows are stored bottom first). The
+/// ([`Output::Rows`]): each band goes to its own place (rows are stored bottom first). The
 /// first error stops the writing and is returned by [`PfmBands::finish`].
 struct PfmBands<'f> {
     /// The file, and the first error writing to it.

@@ -5,15 +5,15 @@ use std::sync::Mutex;
 use glam::Vec3;
 
 use super::threads::{next_band, on_every_thread};
-use super::{BandDone, TILE};
+use super::{Job, TILE};
 use crate::accel::tri4::Best8;
 use crate::accel::{TILE_RAYS, TileCache};
-use crate::camera::RayGen;
 use crate::geometry::RayTile;
 use crate::rng::first_two8;
 use crate::sampler::{SampleSource, Stream};
-use crate::scene::Scene;
-use crate::shading::{RayCounts, TileScratch, Tracer};
+#[cfg(doc)]
+use crate::shading::Tracer;
+use crate::shading::{RayCounts, TileScratch};
 
 /// Where sample `s` of `samples` falls in its pixel (0 to 1 on each axis), stratified: the
 /// sampler's own offset (Sobol points are), else an s×s grid when `samples` is square, else
@@ -71,23 +71,15 @@ impl Cell {
     }
 }
 
-/// `pixels` (`w` wide) of a frame of `samples` samples whose light is not path traced
-/// ([`Tracer::shades_tiles`]): per tile, each sample's camera rays (jittered as
+/// Renders `job`'s frame into `pixels`, a frame of several samples whose light is not path
+/// traced ([`Tracer::shades_tiles`]): per tile, each sample's camera rays (jittered as
 /// [`pixel_offset`] puts them, from independent numbers) are traced and shaded together, and
 /// added to their pixels in the samples' order, so every pixel gets the sums one ray at a time
-/// would give. Bands of rows go to every thread as the one-sample frame's do; `done` gets each
-/// band when it is finished.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn by_tile(
-    pixels: &mut [Vec3],
-    w: usize,
-    samples: u32,
-    frame: u32,
-    rays: &RayGen,
-    scene: &Scene,
-    tracer: &Tracer,
-    done: Option<BandDone>,
-) -> RayCounts {
+/// would give. Bands of rows go to every thread as the one-sample frame's do; `job.done` gets
+/// each band when it is finished.
+pub(super) fn render(job: &Job, pixels: &mut [Vec3]) -> RayCounts {
+    let (scene, tracer, rays) = (job.scene, &job.tracer, &job.rays);
+    let (w, samples, frame, done) = (job.width, job.samples, job.frame, job.done);
     let h = pixels.len() / w.max(1);
     let bands = Mutex::new(pixels.chunks_mut(TILE * w).enumerate());
     on_every_thread(h.div_ceil(TILE), |from_back| {

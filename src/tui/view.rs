@@ -9,8 +9,7 @@ use raytty::bench::timing::ms;
 use raytty::denoise::{Guides, denoise};
 use raytty::frame::{CellMode, DiffLimits, UNLIKE, distance, encode_diff_within};
 use raytty::{
-    Camera, CellGrid, ColorMode, FrameStats, HitCache, Image, Stage, printable, render_cached,
-    render_guided,
+    Camera, CellGrid, ColorMode, FrameStats, HitCache, Image, Options, Output, Stage, printable,
 };
 
 use super::app::App;
@@ -194,16 +193,16 @@ impl Screen {
         }
         let mut settings = app.stage.settings(app.scene.effects());
         settings.frame = self.passes;
+        let options = Options {
+            width: w,
+            height: h,
+            settings: Some(settings),
+            camera: Some(app.camera),
+            lights: Some(&app.lights),
+            ..Options::default()
+        };
         if app.stage != Stage::Gi {
-            let frame = render_cached(
-                &app.scene,
-                &app.camera,
-                &app.lights,
-                &settings,
-                w,
-                h,
-                &mut self.cache,
-            );
+            let frame = self.cache.render(&app.scene, &options);
             self.stats.render = frame.stats;
             self.passes = GI_MAX_PASSES;
             self.guides = None;
@@ -213,15 +212,10 @@ impl Screen {
             return;
         }
         if self.passes < GI_MAX_PASSES {
-            let frame = render_guided(
-                &app.scene,
-                &app.camera,
-                &app.lights,
-                &settings,
-                w,
-                h,
-                &mut self.cache,
-            );
+            let output = Output::Guides;
+            let frame = self
+                .cache
+                .render(&app.scene, &Options { output, ..options });
             self.stats.render = frame.stats;
             self.spent += frame.stats.elapsed;
             if let Some(new) = frame.guides {

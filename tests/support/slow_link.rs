@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system};
 use raytty::frame::{Colour, pixels};
-use raytty::{Camera, CellGrid, ColorMode, PointLight, Stage, cornell_box, render};
+use raytty::{Camera, CellGrid, ColorMode, Options, PointLight, Stage, cornell_box};
 
 /// The most the link lets through at once after an idle spell, in time at its rate (a real
 /// link's queue): long enough that the reader's own scheduling delays on a busy machine do not
@@ -272,13 +272,13 @@ pub fn max_error(screen: &vt100::Screen, want: &CellGrid) -> u16 {
 pub fn app_image(camera: &Camera, lights: &[PointLight], cols: u16, rows: u16) -> CellGrid {
     let scene = cornell_box();
     let settings = Stage::Indirect.settings(scene.effects());
-    let frame = render(
-        &scene,
-        camera,
-        lights,
-        &settings,
-        u32::from(cols),
-        2 * (u32::from(rows) - 1),
-    );
+    let frame = scene.render(&Options {
+        width: u32::from(cols),
+        height: 2 * (u32::from(rows) - 1),
+        settings: Some(settings),
+        camera: Some(*camera),
+        lights: Some(lights),
+        ..Options::default()
+    });
     CellGrid::from_image(&frame.image, ColorMode::TrueColor)
 }
