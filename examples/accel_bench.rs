@@ -8,7 +8,7 @@
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use raytty::bench::scene::bench_scene;
+use raytty::bench::scene::{SceneBench, bench_scene};
 use raytty::scene::cornell::colours;
 use raytty::scene::procedural::displaced_icosphere;
 use raytty::{AccelKind, Camera, Effects, Material, Scene, SceneBuilder, cornell_box};
@@ -27,6 +27,22 @@ fn thread_time() -> Duration {
 }
 
 static EPOCH: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+
+/// A line per size: median frame time and M rays/s.
+fn frames(b: &SceneBench) -> String {
+    let mut s = format!("built in {:.1} ms\n", b.accel.build.as_secs_f64() * 1e3);
+    for z in &b.sizes {
+        s += &format!(
+            "- {}×{}: {:.2} ms median of {} frames, {:.2} M rays/s\n",
+            z.width,
+            z.height,
+            z.median.as_secs_f64() * 1e3,
+            z.runs,
+            z.mrays_per_s()
+        );
+    }
+    s
+}
 
 /// Closest-hit queries per second of this thread's time (best of 5), for the camera rays of a
 /// `w`×`h` frame.
@@ -132,7 +148,7 @@ fn main() {
     for kind in [AccelKind::Flat, AccelKind::Bvh] {
         let scene = cornell_box().with_accel(kind);
         println!("### {}\n", kind.name());
-        print!("{}", bench_scene(&scene, &sizes, RUNS).to_markdown());
+        print!("{}", frames(&bench_scene(&scene, &sizes, RUNS)));
         println!(
             "\nclosest hit, camera rays 500×500, one thread's time: {:.2} M rays/s\n",
             trace_rate(&scene, 500, 500)
@@ -179,7 +195,7 @@ fn main() {
     if let Some(mib) = peak_rss_mib() {
         println!("peak RSS after building: {mib:.0} MiB\n");
     }
-    print!("{}", bench_scene(&scene, &sizes, RUNS).to_markdown());
+    print!("{}", frames(&bench_scene(&scene, &sizes, RUNS)));
     println!(
         "\nclosest hit, camera rays 500×500, one thread's time: BVH {:.2} M rays/s",
         trace_rate(&scene, 500, 500)

@@ -1,5 +1,5 @@
 //! `raytty bench --quick` end to end: the table's shape, the CSV, the SVG plot, the reference
-//! cache, and the README rewrite (only between the markers).
+//! cache, and the report file (stamped, holding what was printed).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -24,6 +24,7 @@ impl Drop for TempDir {
 
 fn bench(cache: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_raytty"))
+        .current_dir(cache)
         .arg("bench")
         .arg("--quick")
         .args(args)
@@ -318,40 +319,60 @@ fn the_svg_is_well_formed_with_one_polyline_per_bounce_count() {
 }
 
 #[test]
-fn the_readme_changes_only_between_the_markers() {
-    let dir = TempDir::new("readme");
-    let path = dir.0.join("README.md");
-    let before = "# raytty\n\nSome text | with a pipe.\n\n## What accuracy costs\n\n\
-                  <!-- bench:start -->\nold table\n<!-- bench:end -->\n\nAfter the table.\n";
-    std::fs::write(&path, before).unwrap();
-    let out = bench(&dir.0, &["--readme", path.to_str().unwrap()]);
+fn the_report_is_stamped_and_holds_the_printed_tables() {
+    let dir = TempDir::new("report");
+    std::fs::create_dir(dir.0.join("docs")).unwrap();
+    let path = dir.0.join("docs/performance.md");
+    std::fs::write(&path, "an old report\n").unwrap();
+    let out = bench(
+        &dir.0,
+        &["--report", "docs/performance.md", "--svg", "docs/bench.svg"],
+    );
     assert!(out.status.success(), "{}", text(&out.stderr));
-    let after = std::fs::read_to_string(&path).unwrap();
-    let start = "<!-- bench:start -->";
-    let end = "<!-- bench:end -->";
-    let (head, _) = before.split_once(start).unwrap();
-    let (_, tail) = before.split_once(end).unwrap();
-    assert!(after.starts_with(&format!("{head}{start}\n")));
-    assert!(after.ends_with(&format!("\n{end}{tail}")));
-    let inner = &after[head.len() + start.len()..after.len() - tail.len() - end.len()];
-    assert!(!inner.contains("old table"));
+    let report = std::fs::read_to_string(&path).unwrap();
+    let stdout = text(&out.stdout);
+    assert!(report.starts_with("# Performance\n"), "{report}");
+    assert!(!report.contains("an old report"));
+    // The chart is linked from the report's folder, and the report ends with what was printed.
+    assert!(report.contains("](bench.svg)"), "{report}");
+    assert!(dir.0.join("docs/bench.svg").is_file());
+    assert!(report.ends_with(&stdout), "{report}");
     assert_eq!(
-        inner.lines().filter(|l| l.starts_with('|')).count(),
+        report.lines().filter(|l| l.starts_with('|')).count(),
         2 + SIZES * ROWS_PER_SIZE + THROUGHPUT_LINES
     );
-    // The table in the README is the one printed.
-    assert_eq!(inner.trim(), text(&out.stdout).trim());
+    // The stamp: the date, the commit (no git checkout here: the crate's version), the machine
+    // and the command.
+    let stamp = |name: &str| {
+        stdout
+            .lines()
+            .find_map(|l| l.strip_prefix(&format!("- {name}: ")))
+            .unwrap_or_else(|| panic!("no {name} in {stdout}"))
+            .to_string()
+    };
+    assert!(stamp("Date").ends_with(" UTC"));
+    assert_eq!(
+        stamp("Commit"),
+        format!("raytty {}", env!("CARGO_PKG_VERSION"))
+    );
+    let machine = stamp("Machine");
+    assert!(
+        machine.contains(" cores, SIMD path ") && machine.ends_with(" threads"),
+        "{machine}"
+    );
+    assert!(stamp("Command").contains("--report docs/performance.md"));
 }
 
 #[test]
-fn a_readme_without_markers_or_a_bad_size_is_a_usage_error() {
+fn a_report_in_a_missing_folder_or_a_bad_size_is_a_usage_error() {
     let dir = TempDir::new("bad");
-    let path = dir.0.join("README.md");
-    std::fs::write(&path, "# no markers\n").unwrap();
-    let out = bench(&dir.0, &["--readme", path.to_str().unwrap()]);
+    let out = bench(&dir.0, &["--report", "nowhere/performance.md"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(text(&out.stderr).contains("<!-- bench:start -->"));
-    assert_eq!(std::fs::read_to_string(&path).unwrap(), "# no markers\n");
+    assert!(
+        text(&out.stderr).contains("the folder nowhere does not exist"),
+        "{}",
+        text(&out.stderr)
+    );
     // Nothing was rendered, so nothing was cached.
     assert!(!dir.0.join("raytty").exists());
     for bad in [
@@ -359,6 +380,7 @@ fn a_readme_without_markers_or_a_bad_size_is_a_usage_error() {
         &["--sizes", "10"],
         &["--runs", "0"],
         &["--max-spp", "x"],
+        &["--report", "r.md", "--csv"],
     ] {
         let out = bench(&dir.0, bad);
         assert_eq!(out.status.code(), Some(2), "{bad:?}");

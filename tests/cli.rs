@@ -409,8 +409,12 @@ fn a_closed_stdout_is_an_error_and_a_closed_pipe_is_not() {
 #[test]
 fn a_bench_file_error_says_its_cause_once() {
     let cache = std::env::temp_dir().join(format!("raytty-cli-cache-{}", std::process::id()));
+    // A report path that is a folder: found out only when the report is written.
+    let report = cache.join("report.md");
+    std::fs::create_dir_all(&report).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_raytty"))
-        .args(["bench", "--quick", "--readme", "/nonexistent/README.md"])
+        .args(["bench", "--quick", "--report"])
+        .arg(&report)
         .env("XDG_CACHE_HOME", &cache)
         .output()
         .unwrap();
@@ -418,7 +422,10 @@ fn a_bench_file_error_says_its_cause_once() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
-        err.ends_with("raytty: cannot read /nonexistent/README.md: No such file or directory\n"),
+        err.ends_with(&format!(
+            "raytty: cannot write {}: Is a directory\n",
+            report.display()
+        )),
         "{err}"
     );
 }

@@ -2,19 +2,14 @@
 //! (or any scene) at one size with one set of effects, several times after a warm-up, and is
 //! compared with a path-traced reference that is rendered once and cached on disk.
 //!
-//! The library side of the command: the rows, the timing, the errors, and the outputs (a
-//! Markdown table, CSV, an SVG plot, the README block). The binary only parses the flags.
+//! The library side of the command is the measuring: the rows, the timing, the errors against
+//! the reference. Writing it out (tables, CSV, the charts, docs/performance.md) is the binary's.
 
-pub mod command;
 mod environment;
 pub mod metrics;
-pub mod output;
-pub mod plot;
 pub mod progress;
 pub mod reference;
 pub mod scene;
-pub mod svg;
-pub mod table;
 pub mod throughput;
 pub mod timing;
 
@@ -29,12 +24,9 @@ use crate::sampler::Sampler;
 use crate::scene::{Effects, Indirect, Scene};
 use crate::shading::{GI_MAX_BOUNCES, Mode, RayCounts, Settings, Stage};
 
-pub use command::{BenchError, BenchRequest, check_sizes, run_command};
 use environment::{load_average, machine, utc_now};
-pub use output::{csv, markdown, rewrite_readme};
 pub use progress::{NoProgress, Progress};
 pub use reference::{ReferenceInfo, ReferenceSpec};
-pub use svg::svg;
 use timing::{Runs, ms};
 
 /// The seed's stages that get a row each (stage 6, GI, has its own rows).
@@ -269,6 +261,10 @@ pub struct Environment {
     pub date: String,
     /// The CPU model (from /proc/cpuinfo where there is one) and the architecture.
     pub machine: String,
+    /// Cores (hardware threads) the process may run on.
+    pub cores: usize,
+    /// The SIMD path the kernels took.
+    pub simd: &'static str,
     /// Threads the renders ran on (rayon's pool).
     pub threads: usize,
     /// One-minute load averages at the start and the end (where the OS reports them).
@@ -353,6 +349,8 @@ pub fn run(
         environment: Environment {
             date: utc_now(),
             machine: machine(),
+            cores: std::thread::available_parallelism().map_or(1, usize::from),
+            simd: scene.isa().name(),
             threads: rayon::current_num_threads(),
             load: load_start.zip(load_end),
         },

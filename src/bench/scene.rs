@@ -4,11 +4,9 @@
 //! This is the library side of `raytty bench --scene NAME`; the numbers it reports depend on
 //! the machine, so no test asserts them.
 
-use std::fmt::Write as _;
 use std::time::Duration;
 
-use super::table::{Align, Table};
-use super::timing::{self, Runs, ms};
+use super::timing::{self, Runs};
 use crate::accel::AccelStats;
 use crate::render::Options;
 use crate::scene::Scene;
@@ -107,47 +105,6 @@ pub fn bench_scene(scene: &Scene, sizes: &[(u32, u32)], runs: u32) -> SceneBench
     }
 }
 
-impl SceneBench {
-    /// A Markdown report: one line on the structure, a table of frame times.
-    pub fn to_markdown(&self) -> String {
-        let a = &self.accel;
-        let mut s = String::new();
-        let _ = writeln!(
-            s,
-            "Scene `{}`: {} triangles, {} ({} nodes, depth {}), built in {:.1} ms; {} threads.\n",
-            self.scene,
-            a.triangles,
-            a.kind.name(),
-            a.nodes,
-            a.depth,
-            ms(a.build),
-            self.threads
-        );
-        let mut table = Table::new([
-            ("size", Align::Left),
-            ("runs", Align::Right),
-            ("median ms", Align::Right),
-            ("min ms", Align::Right),
-            ("max ms", Align::Right),
-            ("rays/frame", Align::Right),
-            ("M rays/s", Align::Right),
-        ]);
-        for z in &self.sizes {
-            table.row([
-                format!("{}×{}", z.width, z.height),
-                z.runs.to_string(),
-                format!("{:.2}", ms(z.median)),
-                format!("{:.2}", ms(z.min)),
-                format!("{:.2}", ms(z.max)),
-                z.rays.to_string(),
-                format!("{:.2}", z.mrays_per_s()),
-            ]);
-        }
-        s.push_str(&table.to_markdown());
-        s
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -164,11 +121,5 @@ mod tests {
             // One primary ray per pixel, and shadow rays for the lit ones.
             assert!(z.rays >= u64::from(z.width * z.height));
         }
-        let md = b.to_markdown();
-        assert!(
-            md.contains("| 8×4 | 3 |") && md.contains("| 16×8 | 3 |"),
-            "{md}"
-        );
-        assert!(md.starts_with("Scene `cornell`: 30 triangles"), "{md}");
     }
 }

@@ -9,13 +9,11 @@
 //! A batch is traced once untimed, then `runs` times ([`timing::measure`], timed by the clock
 //! around the tracing alone); the median counts.
 
-use std::fmt::Write as _;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::table::{Align, Table};
 use super::timing::{self, Runs};
 use crate::accel::Isa;
 use crate::geometry::{Ray, hit_point, offset_ray_origin};
@@ -196,44 +194,4 @@ pub fn measure(scene: &Scene, width: u32, height: u32, runs: u32) -> Throughput 
         threads: rayon::current_num_threads(),
         kinds,
     }
-}
-
-/// The throughput section: a heading line and one Markdown table, a row per scene and kind.
-pub fn markdown(results: &[Throughput]) -> String {
-    let mut s = String::new();
-    let Some(first) = results.first() else {
-        return s;
-    };
-    let _ = writeln!(
-        s,
-        "Ray throughput (tracing only, no shading; SIMD path: {}; `all` = {} threads):\n",
-        first.isa.name(),
-        first.threads
-    );
-    let mut table = Table::new([
-        ("scene", Align::Left),
-        ("triangles", Align::Right),
-        ("structure", Align::Left),
-        ("rays from", Align::Left),
-        ("kind", Align::Left),
-        ("rays", Align::Right),
-        ("M rays/s, 1 thread", Align::Right),
-        ("M rays/s, all", Align::Right),
-    ]);
-    for t in results {
-        for k in &t.kinds {
-            table.row([
-                t.scene.clone(),
-                t.triangles.to_string(),
-                t.accel.to_string(),
-                format!("{}×{}", t.width, t.height),
-                k.kind.to_string(),
-                k.rays.to_string(),
-                format!("{:.2}", k.one_thread),
-                format!("{:.2}", k.all_threads),
-            ]);
-        }
-    }
-    s.push_str(&table.to_markdown());
-    s
 }

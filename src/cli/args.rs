@@ -181,7 +181,7 @@ pub(super) enum Command {
     /// Render one frame to stdout or a file (text frames or images).
     Render(RenderArgs),
     /// Measure what each step of accuracy costs: time per frame against error from a cached
-    /// path-traced reference (a Markdown table, or CSV; an SVG plot; the README's table).
+    /// path-traced reference (a Markdown table, or CSV; an SVG plot; the report file, docs/performance.md).
     Bench(BenchArgs),
     /// List the built-in scenes with their triangle counts.
     Scenes,
@@ -214,9 +214,10 @@ pub(super) struct BenchArgs {
     /// Write the error-against-time plot (log axes) to PATH as SVG.
     #[arg(long, value_name = "PATH", conflicts_with = "scene")]
     pub(super) svg: Option<PathBuf>,
-    /// Rewrite the table between <!-- bench:start --> and <!-- bench:end --> in PATH.
-    #[arg(long, value_name = "PATH", conflicts_with = "scene")]
-    pub(super) readme: Option<PathBuf>,
+    /// Write the report (the stamp, the tables, a link to the SVG) to PATH, e.g.
+    /// docs/performance.md.
+    #[arg(long, value_name = "PATH", conflicts_with_all = ["scene", "csv"])]
+    pub(super) report: Option<PathBuf>,
     /// Tiny sizes, 2 runs, a small reference: seconds, for tests.
     #[arg(long)]
     pub(super) quick: bool,

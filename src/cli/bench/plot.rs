@@ -5,9 +5,9 @@
 
 use std::fmt::Write as _;
 
-use super::output::{GOAL_MS, GOAL_RMSE, sizes};
+use super::report::{GOAL_MS, GOAL_RMSE, sizes};
 use super::svg::{series, tick};
-use super::{BenchReport, Row, RowKind};
+use raytty::bench::{BenchReport, Row, RowKind};
 
 /// Plot area of one panel, in cells.
 pub const PLOT_COLS: usize = 64;
@@ -89,7 +89,7 @@ fn letter(r: &Row) -> char {
     match r.kind {
         RowKind::Denoised { .. } => 'D',
         RowKind::Independent { .. } => 'I',
-        RowKind::Gi { bounces, .. } if bounces == crate::shading::GI_MAX_BOUNCES => 'R',
+        RowKind::Gi { bounces, .. } if bounces == raytty::shading::GI_MAX_BOUNCES => 'R',
         RowKind::Gi { bounces, .. } => char::from_digit(bounces % 10, 10).unwrap_or('G'),
         RowKind::Aa { .. } => 'a',
         RowKind::Stage(_) => 's',

@@ -1,15 +1,16 @@
-//! The bench's outputs: a Markdown table, CSV, an SVG plot of error against time, and the
-//! README block between its markers.
+//! The bench's text outputs: where and when it ran (the stamp), the Markdown tables (accuracy,
+//! throughput, a scene's frames), CSV, and the report file (docs/performance.md).
 
 use std::fmt::Write as _;
+use std::process::Command;
+
+use raytty::bench::scene::SceneBench;
+use raytty::bench::throughput::Throughput;
+use raytty::bench::timing::ms;
+use raytty::bench::{BenchReport, Environment, GI_BOUNCES, Row, RowKind};
+use raytty::shading::{GI_MAX_BOUNCES, Stage};
 
 use super::table::{Align, Table};
-use super::{BenchReport, Row, RowKind};
-
-/// The README's markers: [`rewrite_readme`] replaces what lies between them.
-pub const README_START: &str = "<!-- bench:start -->";
-/// See [`README_START`].
-pub const README_END: &str = "<!-- bench:end -->";
 
 /// The columns of the Markdown table, in order.
 pub const COLUMNS: [&str; 14] = [
@@ -29,19 +30,10 @@ pub const COLUMNS: [&str; 14] = [
     "ANSI bytes",
 ];
 
-/// The Markdown table, preceded by where and when it was measured (`command` is what produced
-/// it) and followed by how each reference was made and where it is cached.
-pub fn markdown(report: &BenchReport, command: &str) -> String {
-    let env = &report.environment;
+/// The accuracy table, followed by how each reference was made and where it is cached, and a
+/// few figures read off the rows.
+pub fn markdown(report: &BenchReport) -> String {
     let mut s = String::new();
-    let load = env.load.map_or(String::new(), |(a, b)| {
-        format!(", load average {a:.2} at the start and {b:.2} at the end")
-    });
-    let _ = writeln!(
-        s,
-        "Measured {} on {}, {} threads{load}, with `{command}`.\n",
-        env.date, env.machine, env.threads
-    );
     let mut table = Table::new(COLUMNS.iter().map(|&c| {
         let align = match c {
             "size" | "row" => Align::Left,
@@ -103,7 +95,7 @@ pub fn markdown(report: &BenchReport, command: &str) -> String {
                     (r.width, r.height) == (w, h)
                         && r.kind
                             == RowKind::Gi {
-                                bounces: crate::shading::GI_MAX_BOUNCES,
+                                bounces: GI_MAX_BOUNCES,
                                 spp,
                             }
                 })?;
@@ -124,7 +116,7 @@ pub fn markdown(report: &BenchReport, command: &str) -> String {
     for seed in report
         .rows
         .iter()
-        .filter(|r| r.kind == RowKind::Stage(crate::shading::Stage::Indirect))
+        .filter(|r| r.kind == RowKind::Stage(Stage::Indirect))
     {
         let _ = writeln!(
             s,
@@ -134,7 +126,7 @@ pub fn markdown(report: &BenchReport, command: &str) -> String {
             seed.rmse,
             psnr(seed.psnr)
         );
-        let rate: Vec<String> = crate::bench::GI_BOUNCES
+        let rate: Vec<String> = GI_BOUNCES
             .iter()
             .filter_map(|&b| {
                 report
@@ -250,30 +242,154 @@ pub fn csv(report: &BenchReport) -> String {
     s
 }
 
-/// Replaces what lies between the README's markers with `block`, keeping the markers and
-/// everything outside them byte for byte. An error says which marker is missing or misplaced.
-pub fn rewrite_readme(readme: &str, block: &str) -> Result<String, String> {
-    let start = readme
-        .find(README_START)
-        .ok_or_else(|| format!("no {README_START} marker"))?;
-    let end = readme
-        .find(README_END)
-        .ok_or_else(|| format!("no {README_END} marker"))?;
-    let inner = start + README_START.len();
-    if end < inner {
-        return Err(format!("{README_END} comes before {README_START}"));
+/// Where, when and from what the numbers came.
+pub struct Stamp<'a> {
+    /// The measurements' environment.
+    pub environment: &'a Environment,
+    /// `git rev-parse --short HEAD` where the bench ran, or else the crate's version.
+    pub commit: String,
+    /// The command line.
+    pub command: &'a str,
+}
+
+impl<'a> Stamp<'a> {
+    /// The stamp of a bench that just ran: the commit asked of git now.
+    pub fn now(environment: &'a Environment, command: &'a str) -> Stamp<'a> {
+        let git = Command::new("git")
+            .args(["rev-parse", "--short", "HEAD"])
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .and_then(|o| String::from_utf8(o.stdout).ok())
+            .map(|s| s.trim().to_string())
+            .filter(|s| !s.is_empty());
+        Stamp {
+            environment,
+            commit: git.unwrap_or_else(|| format!("raytty {}", env!("CARGO_PKG_VERSION"))),
+            command,
+        }
     }
-    if readme[end + README_END.len()..].contains(README_START)
-        || readme[inner..].contains(README_START)
-    {
-        return Err(format!("more than one {README_START} marker"));
+
+    /// The stamp as a Markdown list.
+    pub fn markdown(&self) -> String {
+        let e = self.environment;
+        let load = e.load.map_or("not reported".to_string(), |(a, b)| {
+            format!("{a:.2} at the start, {b:.2} at the end")
+        });
+        format!(
+            "- Date: {}\n- Commit: {}\n- Machine: {}, {} cores, SIMD path {}, {} threads\n\
+             - Load average: {load}\n- Command: `{}`\n",
+            e.date, self.commit, e.machine, e.cores, e.simd, e.threads, self.command
+        )
     }
-    Ok(format!(
-        "{}\n{}\n{}",
-        &readme[..inner],
-        block.trim_end(),
-        &readme[end..]
-    ))
+}
+
+/// What `raytty bench` prints: the stamp, the accuracy table and the throughput table.
+pub fn body(report: &BenchReport, rates: &[Throughput], stamp: &Stamp) -> String {
+    let mut s = stamp.markdown();
+    s.push('\n');
+    s.push_str(&markdown(report));
+    s.push('\n');
+    s.push_str(&throughput_markdown(rates));
+    s
+}
+
+/// The report file: a title, what it is and how to read it, the chart (`chart`, the SVG's path
+/// relative to the report) and `body`.
+pub fn document(body: &str, chart: Option<&str>) -> String {
+    let mut s = String::from(
+        "# Performance\n\n\
+         Written by `raytty bench --report` (the command is below): run it again rather than \
+         edit this file.\n\n\
+         Each row renders the Cornell box at one size with one set of effects, once as a \
+         warm-up and then at least 5 timed times (fast rows until they add up to 0.5 s), and \
+         compares the image with a path-traced reference, rendered once and cached. The ray \
+         counts and the errors are exact and do not depend on the machine; the times do.\n\n",
+    );
+    if let Some(path) = chart {
+        let _ = writeln!(s, "![Error against time, log axes]({path})\n");
+    }
+    s.push_str(body);
+    s
+}
+
+/// The throughput section: a heading line and one Markdown table, a row per scene and kind.
+pub fn throughput_markdown(results: &[Throughput]) -> String {
+    let mut s = String::new();
+    let Some(first) = results.first() else {
+        return s;
+    };
+    let _ = writeln!(
+        s,
+        "Ray throughput (tracing only, no shading; SIMD path: {}; `all` = {} threads):\n",
+        first.isa.name(),
+        first.threads
+    );
+    let mut table = Table::new([
+        ("scene", Align::Left),
+        ("triangles", Align::Right),
+        ("structure", Align::Left),
+        ("rays from", Align::Left),
+        ("kind", Align::Left),
+        ("rays", Align::Right),
+        ("M rays/s, 1 thread", Align::Right),
+        ("M rays/s, all", Align::Right),
+    ]);
+    for t in results {
+        for k in &t.kinds {
+            table.row([
+                t.scene.clone(),
+                t.triangles.to_string(),
+                t.accel.to_string(),
+                format!("{}×{}", t.width, t.height),
+                k.kind.to_string(),
+                k.rays.to_string(),
+                format!("{:.2}", k.one_thread),
+                format!("{:.2}", k.all_threads),
+            ]);
+        }
+    }
+    s.push_str(&table.to_markdown());
+    s
+}
+
+/// `raytty bench --scene`'s report: one line on the structure, a table of frame times.
+pub fn scene_markdown(b: &SceneBench) -> String {
+    let a = &b.accel;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "Scene `{}`: {} triangles, {} ({} nodes, depth {}), built in {:.1} ms; {} threads.\n",
+        b.scene,
+        a.triangles,
+        a.kind.name(),
+        a.nodes,
+        a.depth,
+        ms(a.build),
+        b.threads
+    );
+    let mut table = Table::new([
+        ("size", Align::Left),
+        ("runs", Align::Right),
+        ("median ms", Align::Right),
+        ("min ms", Align::Right),
+        ("max ms", Align::Right),
+        ("rays/frame", Align::Right),
+        ("M rays/s", Align::Right),
+    ]);
+    for z in &b.sizes {
+        table.row([
+            format!("{}×{}", z.width, z.height),
+            z.runs.to_string(),
+            format!("{:.2}", ms(z.median)),
+            format!("{:.2}", ms(z.min)),
+            format!("{:.2}", ms(z.max)),
+            z.rays.to_string(),
+            format!("{:.2}", z.mrays_per_s()),
+        ]);
+    }
+    s.push_str(&table.to_markdown());
+    s
 }
 
 #[cfg(test)]
@@ -281,23 +397,22 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_readme_changes_only_between_the_markers() {
-        let before =
-            "# Title\n\ntext\n<!-- bench:start -->\nold table\n<!-- bench:end -->\nafter\n";
-        let after = rewrite_readme(before, "new | table\n").unwrap();
-        assert_eq!(
-            after,
-            "# Title\n\ntext\n<!-- bench:start -->\nnew | table\n<!-- bench:end -->\nafter\n"
-        );
-        assert_eq!(rewrite_readme(&after, "new | table").unwrap(), after);
-        assert!(rewrite_readme("no markers", "x").is_err());
-        assert!(rewrite_readme("<!-- bench:end --> <!-- bench:start -->", "x").is_err());
+    fn a_scene_report_has_a_line_per_size() {
+        let b = raytty::bench::scene::bench_scene(&raytty::cornell_box(), &[(8, 4), (16, 8)], 3);
+        let md = scene_markdown(&b);
         assert!(
-            rewrite_readme(
-                "<!-- bench:start --><!-- bench:end --><!-- bench:start -->",
-                "x"
-            )
-            .is_err()
+            md.contains("| 8×4 | 3 |") && md.contains("| 16×8 | 3 |"),
+            "{md}"
         );
+        assert!(md.starts_with("Scene `cornell`: 30 triangles"), "{md}");
+    }
+
+    #[test]
+    fn the_document_links_the_chart_and_keeps_the_body() {
+        let doc = document("- Date: x\n", Some("bench.svg"));
+        assert!(doc.starts_with("# Performance\n"));
+        assert!(doc.contains("](bench.svg)"));
+        assert!(doc.ends_with("- Date: x\n"));
+        assert!(!document("b", None).contains("]("));
     }
 }

@@ -3,8 +3,8 @@
 
 use std::fmt::Write as _;
 
-use super::output::sizes;
-use super::{BenchReport, Row, RowKind};
+use super::report::sizes;
+use raytty::bench::{BenchReport, Row, RowKind};
 
 /// Series colours of the GI polylines, by bounce count (1, 2, 4, 8, then cycling).
 const COLOURS: [&str; 6] = [
@@ -224,7 +224,7 @@ pub fn series<'a>(rows: &[&'a Row]) -> Vec<(String, &'static str, Vec<&'a Row>)>
             .filter(|r| r.kind.raw_bounces() == Some(b))
             .copied()
             .collect();
-        let name = if b == crate::shading::GI_MAX_BOUNCES {
+        let name = if b == raytty::shading::GI_MAX_BOUNCES {
             format!("GI, roulette, ≤ {b} bounces")
         } else {
             format!("GI, {b} bounce{}", if b == 1 { "" } else { "s" })
