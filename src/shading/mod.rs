@@ -38,7 +38,7 @@ pub const MAX_MIRROR_DEPTH: u32 = 8;
 /// Path-traced bounces before this many are always traced; from here on Russian roulette may end
 /// a path. By then a path carries at most 0.75³ ≈ 0.42 of its first hit's weight in the Cornell
 /// box, so ending it early adds little noise and saves the rays of the long tail (measured in
-/// the README's "What accuracy costs").
+/// docs/performance.md).
 pub const ROULETTE_START: u32 = 3;
 
 /// Stage 6's bounce cap: a safety net, not a model. Paths end by Russian roulette; one that
