@@ -9,8 +9,7 @@ mod common;
 
 use common::{Rng, in_cube, soup, uniform};
 use glam::Vec3;
-use raytty::accel::BVH_THRESHOLD;
-use raytty::accel::bvh::{Bvh, MAX_DEPTH};
+use raytty::accel::{BVH_THRESHOLD, MAX_DEPTH};
 use raytty::geometry::intersect_watertight;
 use raytty::scene::procedural::displaced_icosphere;
 use raytty::{
@@ -281,52 +280,6 @@ fn the_cornell_box_uses_the_measured_choice() {
     assert_eq!(AccelKind::for_triangles(BVH_THRESHOLD - 1), AccelKind::Flat);
 }
 
-#[test]
-fn bvh_is_the_same_with_any_number_of_threads() {
-    // Large enough that the top levels split, bin and bound in parallel.
-    let tris: Vec<Triangle> = displaced_icosphere(71, 0.2)
-        .into_iter()
-        .map(|v| Triangle::new(v[0], v[1], v[2], 0).unwrap())
-        .collect();
-    assert!(tris.len() > 100_000);
-    let build = |threads| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| Bvh::build(&tris))
-    };
-    let one = build(1);
-    assert!(one.depth() as usize <= MAX_DEPTH);
-    assert!(one.nodes() > tris.len() / 8);
-    for threads in [2, 3, 8] {
-        assert!(
-            build(threads) == one,
-            "{threads} threads built another tree"
-        );
-    }
-}
-
-#[test]
-fn leaves_hold_a_few_triangles() {
-    let tris: Vec<Triangle> = displaced_icosphere(30, 0.1)
-        .into_iter()
-        .map(|v| Triangle::new(v[0], v[1], v[2], 0).unwrap())
-        .collect();
-    let bvh = Bvh::build(&tris);
-    let per_leaf = tris.len() as f64 / bvh.leaves() as f64;
-    assert!(
-        (1.0..=raytty::accel::bvh::LEAF_MAX as f64).contains(&per_leaf),
-        "{per_leaf} triangles per leaf"
-    );
-    // A binary tree: one more leaf than interior nodes.
-    assert_eq!(bvh.nodes(), 2 * bvh.leaves() - 1);
-    let cost = bvh.sah_cost();
-    assert!(cost.is_finite() && cost > 1.0, "SAH cost {cost}");
-    // A well-balanced tree over 18000 triangles is a few dozen levels at most.
-    assert!(bvh.depth() < 40, "depth {}", bvh.depth());
-}
-
 /// The 1M-triangle sphere (k = 224) against brute force: slow (each brute-force ray tests a
 /// million triangles; 17 s here), so run by hand: `cargo test --test accel -- --ignored`.
 #[test]
@@ -342,20 +295,6 @@ fn wide_nodes_of_every_fill_match_brute_force() {
     // of children and leaves of every size; each must answer as the loop does.
     for n in [1, 2, 9, 17, 40, 64, 100, 300, 1_000, 4_000] {
         let tris = soup(40 + n as u64, n, 1.0, 0.3, 1.0);
-        let s = scene_of(tris.clone(), AccelKind::Bvh);
-        assert_exact(tris.clone(), 41 + n as u64, 400, 1.5);
-        let all: Vec<Triangle> = tris
-            .iter()
-            .map(|v| Triangle::new(v[0], v[1], v[2], 0).unwrap())
-            .collect();
-        let bvh = Bvh::build(&all);
-        assert!(
-            bvh.wide_nodes() <= bvh.nodes() / 2,
-            "{n} triangles: {} wide nodes for {} binary",
-            bvh.wide_nodes(),
-            bvh.nodes()
-        );
-        assert!(bvh.wide_depth() < bvh.depth().max(1), "{n} triangles");
-        assert_eq!(s.accel_stats().nodes, bvh.nodes());
+        assert_exact(tris, 41 + n as u64, 400, 1.5);
     }
 }

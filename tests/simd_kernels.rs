@@ -11,11 +11,9 @@ mod common;
 
 use common::{Rng, in_cube, log_uniform, soup, uniform, unit};
 use glam::Vec3;
-use raytty::accel::box4::Box4;
-use raytty::accel::box8::Box8;
 use raytty::accel::tri4::{Best8, Hits, Tri4, hits as hits_in, hits2};
 use raytty::accel::{Isa, TILE_RAYS, TileCache};
-use raytty::geometry::{Aabb, RayTile, TriHit, intersect_watertight};
+use raytty::geometry::{RayTile, TriHit, intersect_watertight};
 use raytty::scene::procedural::displaced_icosphere;
 use raytty::{
     AccelKind, Camera, Effects, Hit, Material, Options, PointLight, Ray, Scene, SceneBuilder,
@@ -82,7 +80,7 @@ fn rays(seed: u64, tris: &[[Vec3; 3]], n: usize, reach: f32, centre: Vec3) -> Ve
 /// Every path's hits in every block, one block and two at a time, against the scalar test: a
 /// lane is hit exactly when `intersect_watertight` hits it, with its `t` and barycentrics bit
 /// for bit, unless the kernel hands it back to be redone in `f64` (an edge function rounded to
-/// 0), and every SIMD path hands back the same lanes. Returns the number of scalar hits seen
+/// 0), and every path hands back the same lanes. Returns the number of scalar hits seen
 /// and of lanes handed back.
 fn assert_kernels_agree(tris: &[[Vec3; 3]], rays: &[(Ray, f32)], what: &str) -> (usize, usize) {
     let blocks = Tri4::pack(tris.iter().copied());
@@ -104,12 +102,6 @@ fn assert_kernels_agree(tris: &[[Vec3; 3]], rays: &[(Ray, f32)], what: &str) -> 
                     let at =
                         || format!("{what}: ray {r} {ray:?} t_max {t_max} triangle {i} on {isa:?}");
                     if got.redo & 1 << l != 0 {
-                        assert_ne!(
-                            isa,
-                            Isa::Portable,
-                            "{}: the scalar test redoes nothing",
-                            at()
-                        );
                         assert!(got.mask & 1 << l == 0, "{}: hit and redo", at());
                         redo_lanes.push(i);
                         continue;
@@ -134,7 +126,7 @@ fn assert_kernels_agree(tris: &[[Vec3; 3]], rays: &[(Ray, f32)], what: &str) -> 
                     }
                 }
             }
-            if isa == Isa::Avx2 || (isa == Isa::Sse2 && !Isa::Avx2.available()) {
+            if isa == Isa::Portable {
                 redone += redo_lanes.len();
             }
             // Two blocks at once (AVX2's eight lanes) give both blocks' lanes.
@@ -157,18 +149,18 @@ fn assert_kernels_agree(tris: &[[Vec3; 3]], rays: &[(Ray, f32)], what: &str) -> 
                 }
             }
         }
-        // The SIMD paths hand back the same lanes.
+        // Every path hands back the same lanes (the one-lane form's too).
         let redo_of = |isa: Isa| -> Vec<u32> {
             blocks
                 .iter()
                 .map(|b| hits_in(isa, b, &ray, t_max).redo)
                 .collect()
         };
-        if paths.len() > 2 {
+        for &isa in &paths {
             assert_eq!(
-                redo_of(Isa::Sse2),
-                redo_of(Isa::Avx2),
-                "{what}: ray {r} {ray:?}"
+                redo_of(isa),
+                redo_of(Isa::Portable),
+                "{what}: ray {r} {ray:?} on {isa:?}"
             );
         }
     }
@@ -546,109 +538,6 @@ fn cornell_frames_are_identical_on_every_path() {
                     frame(&s) == want,
                     "{stage:?} at {samples} spp differs on {isa:?} {kind:?}"
                 );
-            }
-        }
-    }
-}
-
-#[test]
-fn box_tests_agree_on_every_path() {
-    // Random boxes and rays, with axis-parallel rays and origins on slab planes mixed in (the
-    // NaN cases), compared bit for bit with the portable form and with `Aabb::enter`.
-    let mut rng = Rng::seeded(5);
-    for i in 0..20_000 {
-        let boxes: Vec<Aabb> = (0..4)
-            .map(|_| {
-                let lo = in_cube(&mut rng, 1.0);
-                let size = in_cube(&mut rng, 1.0).abs();
-                Aabb {
-                    min: lo,
-                    max: lo + size,
-                }
-            })
-            .collect();
-        let b = Box4::new(&boxes);
-        let mut origin = in_cube(&mut rng, 2.0);
-        let mut dir = in_cube(&mut rng, 1.0);
-        if i % 3 == 0 {
-            let axis = i % 9 / 3;
-            dir[axis] = 0.0;
-            origin[axis] = if i % 2 == 0 {
-                boxes[0].min[axis]
-            } else {
-                boxes[1].max[axis]
-            };
-        }
-        if dir == Vec3::ZERO {
-            continue;
-        }
-        let ray = Ray::new(origin, dir);
-        let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
-        for t_max in [f32::INFINITY, uniform(&mut rng, 0.0, 3.0)] {
-            let (mask, t) = b.enter_portable(&o, &inv, t_max);
-            // Held to the one slab test, `Aabb::enter`: the same boxes, entered at the same t.
-            for (l, bx) in boxes.iter().enumerate() {
-                let want = bx.enter(&ray, t_max).map(f32::to_bits);
-                let got = (mask & 1 << l != 0).then_some(t[l].to_bits());
-                assert_eq!(got, want, "{ray:?} {bx:?} {t_max}");
-            }
-            #[cfg(target_arch = "x86_64")]
-            {
-                let (m2, t2) = b.enter_sse2(&o, &inv, t_max);
-                assert_eq!(m2, mask, "{ray:?} {t_max}");
-                for l in 0..4 {
-                    if mask & 1 << l != 0 {
-                        assert_eq!(t2[l].to_bits(), t[l].to_bits());
-                    }
-                }
-            }
-            let _ = t;
-        }
-    }
-}
-
-#[test]
-fn wide_box_tests_agree_on_every_path() {
-    // The wide BVH's eight boxes at once (`Box8`): every path against `Aabb::enter`, hit and
-    // entry `t` bit for bit, with axis-parallel rays whose origins lie on slab planes (the NaN
-    // cases) and boxes that share those planes.
-    let mut rng = Rng::seeded(8);
-    for i in 0..20_000 {
-        let boxes: Vec<Aabb> = (0..8)
-            .map(|_| {
-                let lo = in_cube(&mut rng, 1.0);
-                let size = in_cube(&mut rng, 1.0).abs();
-                Aabb {
-                    min: lo,
-                    max: lo + size,
-                }
-            })
-            .collect();
-        let b = Box8::new(&boxes);
-        let mut origin = in_cube(&mut rng, 2.0);
-        let mut dir = in_cube(&mut rng, 1.0);
-        if i % 3 == 0 {
-            let axis = i % 9 / 3;
-            dir[axis] = if i % 6 == 0 { 0.0 } else { -0.0 };
-            origin[axis] = if i % 2 == 0 {
-                boxes[i % 8].min[axis]
-            } else {
-                boxes[(i + 5) % 8].max[axis]
-            };
-        }
-        if dir == Vec3::ZERO {
-            continue;
-        }
-        let ray = Ray::new(origin, dir);
-        let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
-        for t_max in [f32::INFINITY, uniform(&mut rng, 0.0, 3.0)] {
-            for isa in paths() {
-                let (mask, t) = b.enter(isa, &o, &inv, t_max);
-                for (l, bx) in boxes.iter().enumerate() {
-                    let want = bx.enter(&ray, t_max).map(f32::to_bits);
-                    let got = (mask & 1 << l != 0).then_some(t[l].to_bits());
-                    assert_eq!(got, want, "{isa:?} lane {l}: {ray:?} {bx:?} {t_max}");
-                }
             }
         }
     }

@@ -1,7 +1,8 @@
-//! Four boxes at a time: the flat list's object boxes, slab-tested with SSE2 (or the portable
-//! twin, one lane at a time, which `tests/simd_kernels.rs` holds it to bit for bit).
+//! Four boxes at a time: the flat list's object boxes, slab by slab for the slab test
+//! ([`crate::geometry::Aabb::enter`]'s operations, four lanes or one at a time).
 
-use crate::geometry::{Aabb, gamma};
+use crate::geometry::{Aabb, enter_boxes};
+use crate::simd::Lanes;
 
 /// Four boxes, slab by slab: `min[axis][lane]`, `max[axis][lane]`. Unused lanes are empty
 /// boxes (min +∞, max −∞); the slab test does not reject those (its near/far swap makes them
@@ -11,44 +12,6 @@ use crate::geometry::{Aabb, gamma};
 pub struct Box4 {
     min: [[f32; 4]; 3],
     max: [[f32; 4]; 3],
-}
-
-/// The portable slab test of `N` boxes held slab by slab (`min[axis][lane]`), one lane at a
-/// time: which the ray meets for some `t` in `[0, t_max]` (bit per lane) and where it enters
-/// each, [`Aabb::enter`]'s operations in its order (the far side widened by 1 + 2γ₃; a NaN
-/// slab distance constrains nothing). [`Box4`] and `Box8` share it.
-#[inline(always)]
-pub(crate) fn enter_lanes<const N: usize>(
-    min: &[[f32; N]; 3],
-    max: &[[f32; N]; 3],
-    origin: &[f32; 3],
-    inv_dir: &[f32; 3],
-    t_max: f32,
-) -> (u32, [f32; N]) {
-    let widen = 1.0 + 2.0 * gamma(3);
-    let mut t0 = [0.0f32; N];
-    let mut t1 = [t_max; N];
-    for axis in 0..3 {
-        for l in 0..N {
-            let a = (min[axis][l] - origin[axis]) * inv_dir[axis];
-            let b = (max[axis][l] - origin[axis]) * inv_dir[axis];
-            let (near, far) = if a > b { (b, a) } else { (a, b) };
-            let far = far * widen;
-            if near > t0[l] {
-                t0[l] = near;
-            }
-            if far < t1[l] {
-                t1[l] = far;
-            }
-        }
-    }
-    let mut mask = 0;
-    for l in 0..N {
-        if t0[l] <= t1[l] {
-            mask |= 1 << l;
-        }
-    }
-    (mask, t0)
 }
 
 impl Box4 {
@@ -69,43 +32,85 @@ impl Box4 {
     }
 
     /// Which boxes the ray meets for some `t` in `[0, t_max]` (bit per lane), and where it
-    /// enters each: [`Aabb::hit`]'s robust slab test (the far side widened by 1 + 2γ₃; a NaN
-    /// slab distance constrains nothing), one lane at a time.
+    /// enters each: the slab test, `L::N` lanes at a time.
     #[inline(always)]
-    pub fn enter_portable(
+    pub(crate) fn enter<L: Lanes>(
         &self,
         origin: &[f32; 3],
         inv_dir: &[f32; 3],
         t_max: f32,
     ) -> (u32, [f32; 4]) {
-        enter_lanes(&self.min, &self.max, origin, inv_dir, t_max)
+        enter_boxes::<L, 4>(&self.min, &self.max, origin, inv_dir, t_max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::geometry::Ray;
+    use crate::simd::{Isa, Kernel, Path};
+
+    /// [`Box4::enter`] on path `isa`.
+    fn enter(isa: Isa, b: &Box4, o: &[f32; 3], inv: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
+        struct Enter<'a>(&'a Box4, &'a [f32; 3], &'a [f32; 3], f32);
+        impl Kernel for Enter<'_> {
+            type Output = (u32, [f32; 4]);
+            fn run<P: Path>(self) -> Self::Output {
+                self.0.enter::<P::Four>(self.1, self.2, self.3)
+            }
+        }
+        isa.run(Enter(b, o, inv, t_max))
     }
 
-    /// [`Box4::enter_portable`] with SSE2: the same operations four lanes at a time (SSE's
-    /// min/max pick the same operand as the portable comparisons, NaN included).
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    pub fn enter_sse2(&self, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
-        use std::arch::x86_64::*;
-        // SAFETY: SSE2 is part of every x86-64; the loads read whole aligned `[f32; 4]`s.
-        unsafe {
-            let widen = _mm_set1_ps(1.0 + 2.0 * gamma(3));
-            let mut t0 = _mm_setzero_ps();
-            let mut t1 = _mm_set1_ps(t_max);
-            for axis in 0..3 {
-                let o = _mm_set1_ps(origin[axis]);
-                let inv = _mm_set1_ps(inv_dir[axis]);
-                let a = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(self.min[axis].as_ptr()), o), inv);
-                let b = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(self.max[axis].as_ptr()), o), inv);
-                let near = _mm_min_ps(b, a);
-                let far = _mm_mul_ps(_mm_max_ps(a, b), widen);
-                t0 = _mm_max_ps(near, t0);
-                t1 = _mm_min_ps(far, t1);
+    /// Random boxes and rays, with axis-parallel rays and origins on slab planes mixed in (the
+    /// NaN cases): every path against `Aabb::enter`, hit and entry `t` bit for bit.
+    #[test]
+    fn every_path_is_the_slab_test() {
+        let mut rng = crate::rng::Rng::seeded(5);
+        let mut f = |scale: f32| (rng.next_f32() * 2.0 - 1.0) * scale;
+        for i in 0..20_000 {
+            let boxes: Vec<Aabb> = (0..4)
+                .map(|_| {
+                    let lo = Vec3::new(f(1.0), f(1.0), f(1.0));
+                    let size = Vec3::new(f(1.0), f(1.0), f(1.0)).abs();
+                    Aabb {
+                        min: lo,
+                        max: lo + size,
+                    }
+                })
+                .collect();
+            let b = Box4::new(&boxes);
+            let mut origin = Vec3::new(f(2.0), f(2.0), f(2.0));
+            let mut dir = Vec3::new(f(1.0), f(1.0), f(1.0));
+            if i % 3 == 0 {
+                let axis = i % 9 / 3;
+                dir[axis] = 0.0;
+                origin[axis] = if i % 2 == 0 {
+                    boxes[0].min[axis]
+                } else {
+                    boxes[1].max[axis]
+                };
             }
-            let mask = _mm_movemask_ps(_mm_cmple_ps(t0, t1)) as u32;
-            let mut t = [0f32; 4];
-            _mm_storeu_ps(t.as_mut_ptr(), t0);
-            (mask, t)
+            if dir == Vec3::ZERO {
+                continue;
+            }
+            let ray = Ray::new(origin, dir);
+            let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
+            for t_max in [f32::INFINITY, f(3.0).abs()] {
+                let want: Vec<_> = boxes
+                    .iter()
+                    .map(|bx| bx.enter(&ray, t_max).map(f32::to_bits))
+                    .collect();
+                for isa in Isa::ALL.into_iter().filter(|i| i.available()) {
+                    let (mask, t) = enter(isa, &b, &o, &inv, t_max);
+                    let got: Vec<_> = (0..4)
+                        .map(|l| (mask & 1 << l != 0).then_some(t[l].to_bits()))
+                        .collect();
+                    assert_eq!(got, want, "{isa:?} {ray:?} {t_max} {boxes:?}");
+                }
+            }
         }
     }
 }

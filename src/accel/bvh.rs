@@ -8,9 +8,9 @@
 //!
 //! # The same answer as testing every triangle
 //!
-//! [`Bvh::intersect`] returns exactly what a loop over all triangles would: the hit with the
+//! [`Bvh::intersect_isa`] returns exactly what a loop over all triangles would: the hit with the
 //! smallest `t`, and among hits at the same `t` the one with the lowest scene index, each hit
-//! as [`intersect_watertight`](crate::geometry::intersect_watertight) computes it for the query's `t_max`. [`Bvh::occluded`] is true
+//! as [`intersect_watertight`](crate::geometry::intersect_watertight) computes it for the query's `t_max`. [`Bvh::occluded_isa`] is true
 //! exactly when one triangle has such a hit. Only two things could make a traversal differ:
 //!
 //! - A box is skipped only when the ray reaches it beyond [`cull_bound`](super::cull_bound) of the best hit so
@@ -30,16 +30,13 @@ use std::mem::MaybeUninit;
 
 use super::hit::{Hit, cull_bound};
 #[cfg(target_arch = "x86_64")]
-use super::tri4::{Avx2, Sse2};
-use super::tri4::{
-    Closest, Kernel, LANES, Portable, RayLanes, Tri4, blocks_closest, blocks_occluded,
-};
+use super::tri4::{Closest, LANES, RayLanes, Tri4, blocks_closest, blocks_occluded};
 use crate::geometry::{Ray, RayTile, Triangle};
-use crate::simd::Isa;
+use crate::simd::{Isa, Kernel, Path};
 use node::{Node, NodePair};
-use wide::{LEAF, TreeStats, WIDTH, Wide, WideBoxes, leaf_blocks};
+use wide::{LEAF, TreeStats, WIDTH, Wide, leaf_blocks};
 
-pub use build::{LEAF_MAX, SAH_BINS};
+pub use build::LEAF_MAX;
 
 /// Most levels the binary tree has (root = level 1); the builder keeps to it by switching from
 /// SAH to median splits deep down. The wide tree has no more levels than the binary one, so
@@ -104,11 +101,13 @@ impl Bvh {
     }
 
     /// Number of wide nodes (of up to eight children) traversal reads.
+    #[cfg(test)]
     pub fn wide_nodes(&self) -> usize {
         self.nodes.len()
     }
 
     /// Levels of wide nodes above the leaves (0 for a single leaf or none).
+    #[cfg(test)]
     pub fn wide_depth(&self) -> u32 {
         self.wide_depth
     }
@@ -116,65 +115,48 @@ impl Bvh {
     /// The binary tree's SAH cost: the expected number of box-pair and triangle tests for a
     /// random ray that meets the root box (each node weighted by its area over the root's).
     /// Lower is better; compare builds of one scene with it.
+    #[cfg(test)]
     pub fn sah_cost(&self) -> f64 {
         self.tree.sah_cost
     }
 
     /// Number of leaves (the same in the binary and the wide tree).
+    #[cfg(test)]
     pub fn leaves(&self) -> usize {
         self.tree.leaves
     }
 
     /// The closest hit with `t < t_max` (ties go to the lowest scene index), or `None`, on
-    /// the widest SIMD path this CPU has.
-    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        self.intersect_on(Isa::detect(), ray, t_max)
-    }
-
-    /// Whether some triangle has a hit with `t < t_max` (stops at the first found), on the
-    /// widest SIMD path this CPU has.
-    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.occluded_on(Isa::detect(), ray, t_max)
-    }
-
-    /// [`Bvh::intersect`] on path `isa`, which must be available.
-    pub fn intersect_on(&self, isa: Isa, ray: &Ray, t_max: f32) -> Option<Hit> {
-        assert!(isa.available(), "{} is not available", isa.name());
-        self.intersect_isa(isa, ray, t_max)
-    }
-
-    /// [`Bvh::occluded`] on path `isa`, which must be available.
-    pub fn occluded_on(&self, isa: Isa, ray: &Ray, t_max: f32) -> bool {
-        assert!(isa.available(), "{} is not available", isa.name());
-        self.occluded_isa(isa, ray, t_max)
-    }
-
-    /// [`Bvh::intersect_on`] for a caller that knows `isa` is available.
+    /// path `isa`, which must be available (the accelerator's path is checked where it is
+    /// set).
     #[inline]
     pub(super) fn intersect_isa(&self, isa: Isa, ray: &Ray, t_max: f32) -> Option<Hit> {
-        debug_assert!(isa.available(), "{} is not available", isa.name());
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the caller passes an available path.
-            Isa::Avx2 | Isa::Avx512 => unsafe { closest_avx2(self, ray, t_max) },
-            #[cfg(target_arch = "x86_64")]
-            Isa::Sse2 => self.closest::<Sse2>(ray, t_max),
-            _ => self.closest::<Portable>(ray, t_max),
+        struct Q<'a>(&'a Bvh, &'a Ray, f32);
+        impl Kernel for Q<'_> {
+            type Output = Option<Hit>;
+            #[inline(always)]
+            fn run<P: Path>(self) -> Option<Hit> {
+                self.0.closest::<P>(self.1, self.2)
+            }
         }
+        // SAFETY: the caller passes an available path.
+        unsafe { isa.run_unchecked(Q(self, ray, t_max)) }
     }
 
-    /// [`Bvh::occluded_on`] for a caller that knows `isa` is available.
+    /// Whether some triangle has a hit with `t < t_max` (stops at the first found), on path
+    /// `isa`, which must be available.
     #[inline]
     pub(super) fn occluded_isa(&self, isa: Isa, ray: &Ray, t_max: f32) -> bool {
-        debug_assert!(isa.available(), "{} is not available", isa.name());
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the caller passes an available path.
-            Isa::Avx2 | Isa::Avx512 => unsafe { occluded_avx2(self, ray, t_max) },
-            #[cfg(target_arch = "x86_64")]
-            Isa::Sse2 => self.any::<Sse2>(ray, t_max),
-            _ => self.any::<Portable>(ray, t_max),
+        struct Q<'a>(&'a Bvh, &'a Ray, f32);
+        impl Kernel for Q<'_> {
+            type Output = bool;
+            #[inline(always)]
+            fn run<P: Path>(self) -> bool {
+                self.0.any::<P>(self.1, self.2)
+            }
         }
+        // SAFETY: the caller passes an available path.
+        unsafe { isa.run_unchecked(Q(self, ray, t_max)) }
     }
 
     /// [`Bvh::intersect_isa`] for each of `tile`'s rays, into `hits` (as many): the path picked
@@ -188,52 +170,40 @@ impl Bvh {
         hits: &mut [Option<Hit>],
         found: impl Fn(u32),
     ) {
-        debug_assert!(isa.available(), "{} is not available", isa.name());
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the caller passes an available path.
-            Isa::Avx2 | Isa::Avx512 => unsafe { closest_each_avx2(self, tile, t_max, hits, found) },
-            #[cfg(target_arch = "x86_64")]
-            Isa::Sse2 => self.closest_each::<Sse2>(tile, t_max, hits, found),
-            _ => self.closest_each::<Portable>(tile, t_max, hits, found),
+        struct Q<'a, F>(&'a Bvh, &'a RayTile, f32, &'a mut [Option<Hit>], F);
+        impl<F: Fn(u32)> Kernel for Q<'_, F> {
+            type Output = ();
+            #[inline(always)]
+            fn run<P: Path>(self) {
+                let Q(bvh, tile, t_max, hits, found) = self;
+                for (i, h) in hits.iter_mut().enumerate() {
+                    *h = bvh.closest::<P>(&tile.ray(i), t_max);
+                    if let Some(h) = h {
+                        found(h.triangle);
+                    }
+                }
+            }
         }
+        // SAFETY: the caller passes an available path.
+        unsafe { isa.run_unchecked(Q(self, tile, t_max, hits, found)) }
     }
 
     /// [`Bvh::occluded_isa`] for each of `rays`, into `out` (as many): the path picked once
     /// for them all. `isa` must be available.
     pub(super) fn occluded_each(&self, isa: Isa, rays: &[Ray], t_max: f32, out: &mut [bool]) {
-        debug_assert!(isa.available(), "{} is not available", isa.name());
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the caller passes an available path.
-            Isa::Avx2 | Isa::Avx512 => unsafe { any_each_avx2(self, rays, t_max, out) },
-            #[cfg(target_arch = "x86_64")]
-            Isa::Sse2 => self.any_each::<Sse2>(rays, t_max, out),
-            _ => self.any_each::<Portable>(rays, t_max, out),
-        }
-    }
-
-    #[inline(always)]
-    fn closest_each<K: Kernel + WideBoxes>(
-        &self,
-        tile: &RayTile,
-        t_max: f32,
-        hits: &mut [Option<Hit>],
-        found: impl Fn(u32),
-    ) {
-        for (i, h) in hits.iter_mut().enumerate() {
-            *h = self.closest::<K>(&tile.ray(i), t_max);
-            if let Some(h) = h {
-                found(h.triangle);
+        struct Q<'a>(&'a Bvh, &'a [Ray], f32, &'a mut [bool]);
+        impl Kernel for Q<'_> {
+            type Output = ();
+            #[inline(always)]
+            fn run<P: Path>(self) {
+                let Q(bvh, rays, t_max, out) = self;
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = bvh.any::<P>(r, t_max);
+                }
             }
         }
-    }
-
-    #[inline(always)]
-    fn any_each<K: Kernel + WideBoxes>(&self, rays: &[Ray], t_max: f32, out: &mut [bool]) {
-        for (o, r) in out.iter_mut().zip(rays) {
-            *o = self.any::<K>(r, t_max);
-        }
+        // SAFETY: the caller passes an available path.
+        unsafe { isa.run_unchecked(Q(self, rays, t_max, out)) }
     }
 
     /// A leaf's blocks and their lanes' scene indices.
@@ -248,7 +218,7 @@ impl Bvh {
     }
 
     #[inline(always)]
-    fn closest<K: Kernel + WideBoxes>(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+    fn closest<P: Path>(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         if self.blocks.is_empty() {
             return None;
         }
@@ -267,13 +237,13 @@ impl Bvh {
                 let (blocks, ids) = self.leaf(cur);
                 // The scene indices are read only for a hit, after the kernel: ask for them now.
                 prefetch(ids.as_ptr());
-                blocks_closest::<K>(blocks, ids, ray, &r, &mut c);
+                blocks_closest::<P>(blocks, ids, ray, &r, &mut c);
                 if let Some(h) = c.best {
                     bound = cull_bound(h.t);
                 }
             } else {
                 let node = &self.nodes[cur as usize];
-                let (mask, t) = K::enter(&node.boxes, &o, &inv, bound);
+                let (mask, t) = node.boxes.enter_lanes::<P::Eight>(&o, &inv, bound);
                 let mut mask = mask & node.valid;
                 if mask != 0 {
                     let l = mask.trailing_zeros() as usize;
@@ -323,7 +293,7 @@ impl Bvh {
     }
 
     #[inline(always)]
-    fn any<K: Kernel + WideBoxes>(&self, ray: &Ray, t_max: f32) -> bool {
+    fn any<P: Path>(&self, ray: &Ray, t_max: f32) -> bool {
         if self.blocks.is_empty() {
             return false;
         }
@@ -335,12 +305,12 @@ impl Bvh {
         let mut cur = self.root;
         loop {
             if cur & LEAF != 0 {
-                if blocks_occluded::<K>(self.leaf(cur).0, ray, &r, t_max) {
+                if blocks_occluded::<P>(self.leaf(cur).0, ray, &r, t_max) {
                     return true;
                 }
             } else {
                 let node = &self.nodes[cur as usize];
-                let (mask, _) = K::enter(&node.boxes, &o, &inv, bound);
+                let (mask, _) = node.boxes.enter_lanes::<P::Eight>(&o, &inv, bound);
                 let mut mask = mask & node.valid;
                 if mask != 0 {
                     cur = node.child[mask.trailing_zeros() as usize];
@@ -387,39 +357,88 @@ fn prefetch<T>(p: *const T) {
     let _ = p;
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn closest_avx2(bvh: &Bvh, ray: &Ray, t_max: f32) -> Option<Hit> {
-    bvh.closest::<Avx2>(ray, t_max)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn closest_each_avx2(
-    bvh: &Bvh,
-    tile: &RayTile,
-    t_max: f32,
-    hits: &mut [Option<Hit>],
-    found: impl Fn(u32),
-) {
-    bvh.closest_each::<Avx2>(tile, t_max, hits, found);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn any_each_avx2(bvh: &Bvh, rays: &[Ray], t_max: f32, out: &mut [bool]) {
-    bvh.any_each::<Avx2>(rays, t_max, out);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn occluded_avx2(bvh: &Bvh, ray: &Ray, t_max: f32) -> bool {
-    bvh.any::<Avx2>(ray, t_max)
-}
-
 #[cfg(test)]
 mod tests {
+    use glam::Vec3;
+
+    use super::*;
     use crate::accel::shrunk_t_max;
+    use crate::scene::procedural::displaced_icosphere;
+
+    fn triangles(mesh: Vec<[Vec3; 3]>) -> Vec<Triangle> {
+        mesh.into_iter()
+            .map(|v| Triangle::new(v[0], v[1], v[2], 0).unwrap())
+            .collect()
+    }
+
+    #[test]
+    fn the_same_tree_with_any_number_of_threads() {
+        // Large enough that the top levels split, bin and bound in parallel.
+        let tris = triangles(displaced_icosphere(71, 0.2));
+        assert!(tris.len() > 100_000);
+        let build = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| Bvh::build(&tris))
+        };
+        let one = build(1);
+        assert!(one.depth() as usize <= MAX_DEPTH);
+        assert!(one.nodes() > tris.len() / 8);
+        for threads in [2, 3, 8] {
+            assert!(
+                build(threads) == one,
+                "{threads} threads built another tree"
+            );
+        }
+    }
+
+    #[test]
+    fn leaves_hold_a_few_triangles() {
+        let tris = triangles(displaced_icosphere(30, 0.1));
+        let bvh = Bvh::build(&tris);
+        let per_leaf = tris.len() as f64 / bvh.leaves() as f64;
+        assert!(
+            (1.0..=LEAF_MAX as f64).contains(&per_leaf),
+            "{per_leaf} triangles per leaf"
+        );
+        // A binary tree: one more leaf than interior nodes.
+        assert_eq!(bvh.nodes(), 2 * bvh.leaves() - 1);
+        let cost = bvh.sah_cost();
+        assert!(cost.is_finite() && cost > 1.0, "SAH cost {cost}");
+        // A well-balanced tree over 18000 triangles is a few dozen levels at most.
+        assert!(bvh.depth() < 40, "depth {}", bvh.depth());
+    }
+
+    /// Random soups from a single leaf up to a few thousand triangles collapse into at most
+    /// half as many wide nodes as binary ones, and fewer levels (`tests/accel.rs` holds their
+    /// answers to brute force).
+    #[test]
+    fn wide_nodes_are_fewer_and_shallower() {
+        let mut rng = crate::rng::Rng::seeded(40);
+        let mut f = |r: f32| (rng.next_f32() * 2.0 - 1.0) * r;
+        for n in [1, 2, 9, 17, 40, 64, 100, 300, 1_000, 4_000] {
+            let mesh: Vec<[Vec3; 3]> = (0..n)
+                .map(|_| {
+                    let c = Vec3::new(f(1.0), f(1.0), f(1.0));
+                    [0, 1, 2].map(|_| c + Vec3::new(f(0.3), f(0.3), f(0.3)))
+                })
+                .collect();
+            let tris: Vec<Triangle> = mesh
+                .into_iter()
+                .filter_map(|v| Triangle::new(v[0], v[1], v[2], 0).ok())
+                .collect();
+            let bvh = Bvh::build(&tris);
+            assert!(
+                bvh.wide_nodes() <= bvh.nodes() / 2,
+                "{n} triangles: {} wide nodes for {} binary",
+                bvh.wide_nodes(),
+                bvh.nodes()
+            );
+            assert!(bvh.wide_depth() < bvh.depth().max(1), "{n} triangles");
+        }
+    }
 
     #[test]
     fn shrunk_t_max_is_above_best_and_capped() {

@@ -9,10 +9,8 @@ use std::ops::Range;
 
 use super::box4::Box4;
 use super::hit::{Hit, cull_bound};
-use super::tri4::{
-    Best8, Closest, Kernel, LANES, Portable, RayLanes, Tri4, blocks_closest, blocks_occluded,
-};
-use crate::simd::Isa;
+use super::tri4::{Best8, Closest, LANES, RayLanes, Tri4, blocks_closest, blocks_occluded};
+use crate::simd::{Isa, Kernel, Path};
 use glam::Vec3;
 
 use crate::geometry::{Aabb, Ray, RayTile, TILE_RAYS, Triangle};
@@ -90,20 +88,21 @@ impl Flat {
 
     /// Closest hit on path `isa` (must be available).
     pub fn intersect(&self, isa: Isa, ray: &Ray, t_max: f32) -> Option<Hit> {
-        debug_assert!(isa.available(), "{} is not available", isa.name());
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the caller passes an available path.
-            Isa::Avx2 | Isa::Avx512 => unsafe { closest_avx2(self, ray, t_max) },
-            #[cfg(target_arch = "x86_64")]
-            Isa::Sse2 => closest::<super::tri4::Sse2>(self, ray, t_max),
-            _ => closest::<Portable>(self, ray, t_max),
+        struct Q<'a>(&'a Flat, &'a Ray, f32);
+        impl Kernel for Q<'_> {
+            type Output = Option<Hit>;
+            #[inline(always)]
+            fn run<P: Path>(self) -> Option<Hit> {
+                closest::<P>(self.0, self.1, self.2)
+            }
         }
+        // SAFETY: the caller passes an available path.
+        unsafe { isa.run_unchecked(Q(self, ray, t_max)) }
     }
 
     /// The closest hits of `tile`'s rays into `hits` (as many), each as [`Flat::intersect`]
     /// gives it, on path `isa` (must be available). A tile whose rays share their axes (as a
-    /// camera's do) is tested eight rays at a time.
+    /// camera's do) is tested as many rays at a time as the path has lanes.
     pub fn intersect_tile(
         &self,
         isa: Isa,
@@ -112,31 +111,31 @@ impl Flat {
         hits: &mut [Option<Hit>],
         cache: &mut TileCache,
     ) {
-        debug_assert!(isa.available(), "{} is not available", isa.name());
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the caller passes an available path.
-            Isa::Avx2 => unsafe { tile_avx2(self, tile, t_max, hits, cache) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the caller passes an available path.
-            Isa::Avx512 => unsafe { tile_avx512(self, tile, t_max, hits, cache) },
-            #[cfg(target_arch = "x86_64")]
-            Isa::Sse2 => {
-                tile::intersect_tile::<super::tri4::Sse2>(self, tile, t_max, hits, cache, |r| {
-                    closest::<super::tri4::Sse2>(self, r, t_max)
-                })
+        struct Q<'a>(
+            &'a Flat,
+            &'a RayTile,
+            f32,
+            &'a mut [Option<Hit>],
+            &'a mut TileCache,
+        );
+        impl Kernel for Q<'_> {
+            type Output = ();
+            const SIXTEEN: bool = true;
+            #[inline(always)]
+            fn run<P: Path>(self) {
+                let Q(f, tile, t_max, hits, cache) = self;
+                tile::intersect_tile::<P>(f, tile, t_max, hits, cache, |r| {
+                    closest::<P>(f, r, t_max)
+                });
             }
-            _ => tile::intersect_tile::<Portable>(self, tile, t_max, hits, cache, |r| {
-                closest::<Portable>(self, r, t_max)
-            }),
         }
+        // SAFETY: the caller passes an available path.
+        unsafe { isa.run_unchecked(Q(self, tile, t_max, hits, cache)) }
     }
 
-    /// [`Flat::intersect_tile`] with AVX2 (which the CPU must have), the hits left as the
-    /// kernel makes them: ray `i` is lane `i % 8` of `best[i / 8]`. AVX-512 (`isa`) traces
-    /// sixteen rays at a time, the same hits.
-    #[cfg(target_arch = "x86_64")]
-    pub(crate) fn intersect_tile_best_wide(
+    /// [`Flat::intersect_tile`], the hits left as the kernel makes them: ray `i` is lane
+    /// `i % 8` of `best[i / 8]`. `isa` must be available.
+    pub(crate) fn intersect_tile_best(
         &self,
         isa: Isa,
         tile: &RayTile,
@@ -144,53 +143,66 @@ impl Flat {
         best: &mut [Best8; TILE_RAYS / 8],
         cache: &mut TileCache,
     ) {
-        assert!(
-            matches!(isa, Isa::Avx2 | Isa::Avx512) && isa.available(),
-            "{} is not available",
-            isa.name()
+        struct Q<'a>(
+            &'a Flat,
+            &'a RayTile,
+            f32,
+            &'a mut [Best8; TILE_RAYS / 8],
+            &'a mut TileCache,
         );
-        // SAFETY: checked just above.
-        unsafe {
-            match isa {
-                Isa::Avx512 => tile_best_avx512(self, tile, t_max, best, cache),
-                _ => tile_best_avx2(self, tile, t_max, best, cache),
+        impl Kernel for Q<'_> {
+            type Output = ();
+            const SIXTEEN: bool = true;
+            #[inline(always)]
+            fn run<P: Path>(self) {
+                let Q(f, tile, t_max, best, cache) = self;
+                tile::intersect_tile_best::<P>(f, tile, t_max, best, cache, |r| {
+                    closest::<P>(f, r, t_max)
+                });
             }
         }
+        // SAFETY: the caller passes an available path.
+        unsafe { isa.run_unchecked(Q(self, tile, t_max, best, cache)) }
     }
 
     /// [`Flat::occluded`] for each of `rays`, into `out` (as many), on path `isa` (must be
     /// available): the path picked once for them all.
     pub fn occluded_each(&self, isa: Isa, rays: &[Ray], t_max: f32, out: &mut [bool]) {
-        debug_assert!(isa.available(), "{} is not available", isa.name());
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the caller passes an available path.
-            Isa::Avx2 | Isa::Avx512 => unsafe { occluded_each_avx2(self, rays, t_max, out) },
-            #[cfg(target_arch = "x86_64")]
-            Isa::Sse2 => occluded_all::<super::tri4::Sse2>(self, rays, t_max, out),
-            _ => occluded_all::<Portable>(self, rays, t_max, out),
+        struct Q<'a>(&'a Flat, &'a [Ray], f32, &'a mut [bool]);
+        impl Kernel for Q<'_> {
+            type Output = ();
+            #[inline(always)]
+            fn run<P: Path>(self) {
+                let Q(f, rays, t_max, out) = self;
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = occluded::<P>(f, r, t_max);
+                }
+            }
         }
+        // SAFETY: the caller passes an available path.
+        unsafe { isa.run_unchecked(Q(self, rays, t_max, out)) }
     }
 
     /// Any hit on path `isa` (must be available).
     pub fn occluded(&self, isa: Isa, ray: &Ray, t_max: f32) -> bool {
-        debug_assert!(isa.available(), "{} is not available", isa.name());
-        match isa {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: the caller passes an available path.
-            Isa::Avx2 | Isa::Avx512 => unsafe { occluded_avx2(self, ray, t_max) },
-            #[cfg(target_arch = "x86_64")]
-            Isa::Sse2 => occluded::<super::tri4::Sse2>(self, ray, t_max),
-            _ => occluded::<Portable>(self, ray, t_max),
+        struct Q<'a>(&'a Flat, &'a Ray, f32);
+        impl Kernel for Q<'_> {
+            type Output = bool;
+            #[inline(always)]
+            fn run<P: Path>(self) -> bool {
+                occluded::<P>(self.0, self.1, self.2)
+            }
         }
+        // SAFETY: the caller passes an available path.
+        unsafe { isa.run_unchecked(Q(self, ray, t_max)) }
     }
 
     /// The closest hit among object `o`'s triangles, folded into `c`.
     #[inline(always)]
-    fn object_closest<K: Kernel>(&self, o: usize, ray: &Ray, r: &RayLanes, c: &mut Closest) {
+    fn object_closest<P: Path>(&self, o: usize, ray: &Ray, r: &RayLanes, c: &mut Closest) {
         let obj = &self.objects[o];
         let (b, end) = (obj.first as usize, (obj.first + obj.blocks) as usize);
-        blocks_closest::<K>(
+        blocks_closest::<P>(
             &self.blocks[b..end],
             &self.ids[b * LANES..end * LANES],
             ray,
@@ -201,110 +213,28 @@ impl Flat {
 
     /// Whether one of object `o`'s triangles has a hit before `t_max`.
     #[inline(always)]
-    fn object_occluded<K: Kernel>(&self, o: usize, ray: &Ray, r: &RayLanes, t_max: f32) -> bool {
+    fn object_occluded<P: Path>(&self, o: usize, ray: &Ray, r: &RayLanes, t_max: f32) -> bool {
         let obj = &self.objects[o];
         let (b, end) = (obj.first as usize, (obj.first + obj.blocks) as usize);
-        blocks_occluded::<K>(&self.blocks[b..end], ray, r, t_max)
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn closest_avx2(f: &Flat, ray: &Ray, t_max: f32) -> Option<Hit> {
-    closest::<super::tri4::Avx2>(f, ray, t_max)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn tile_avx2(
-    f: &Flat,
-    tile: &RayTile,
-    t_max: f32,
-    hits: &mut [Option<Hit>],
-    cache: &mut TileCache,
-) {
-    tile::intersect_tile::<super::tri4::Avx2>(f, tile, t_max, hits, cache, |r| {
-        closest::<super::tri4::Avx2>(f, r, t_max)
-    });
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn tile_best_avx2(
-    f: &Flat,
-    tile: &RayTile,
-    t_max: f32,
-    best: &mut [Best8; TILE_RAYS / 8],
-    cache: &mut TileCache,
-) {
-    tile::intersect_tile_best::<super::tri4::Avx2>(f, tile, t_max, best, cache, |r| {
-        closest::<super::tri4::Avx2>(f, r, t_max)
-    });
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
-unsafe fn tile_avx512(
-    f: &Flat,
-    tile: &RayTile,
-    t_max: f32,
-    hits: &mut [Option<Hit>],
-    cache: &mut TileCache,
-) {
-    tile::intersect_tile::<super::tri4::Avx512>(f, tile, t_max, hits, cache, |r| {
-        closest::<super::tri4::Avx512>(f, r, t_max)
-    });
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,avx512f,avx512dq,avx512vl,avx512bw")]
-unsafe fn tile_best_avx512(
-    f: &Flat,
-    tile: &RayTile,
-    t_max: f32,
-    best: &mut [Best8; TILE_RAYS / 8],
-    cache: &mut TileCache,
-) {
-    tile::intersect_tile_best::<super::tri4::Avx512>(f, tile, t_max, best, cache, |r| {
-        closest::<super::tri4::Avx512>(f, r, t_max)
-    });
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn occluded_each_avx2(f: &Flat, rays: &[Ray], t_max: f32, out: &mut [bool]) {
-    occluded_all::<super::tri4::Avx2>(f, rays, t_max, out);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn occluded_avx2(f: &Flat, ray: &Ray, t_max: f32) -> bool {
-    occluded::<super::tri4::Avx2>(f, ray, t_max)
-}
-
-/// [`occluded`] for each ray, into `out`.
-#[inline(always)]
-fn occluded_all<K: Kernel>(f: &Flat, rays: &[Ray], t_max: f32, out: &mut [bool]) {
-    for (o, r) in out.iter_mut().zip(rays) {
-        *o = occluded::<K>(f, r, t_max);
+        blocks_occluded::<P>(&self.blocks[b..end], ray, r, t_max)
     }
 }
 
 #[inline(always)]
-fn closest<K: Kernel>(f: &Flat, ray: &Ray, t_max: f32) -> Option<Hit> {
+fn closest<P: Path>(f: &Flat, ray: &Ray, t_max: f32) -> Option<Hit> {
     let r = RayLanes::new(ray);
     let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
     let mut c = Closest::new(t_max);
     let mut bound = cull_bound(t_max);
     if f.objects.len() > SORTED_MAX {
         for (g, bx) in f.boxes.iter().enumerate() {
-            let (mut mask, t) = K::boxes(bx, &o, &inv, bound);
+            let (mut mask, t) = bx.enter::<P::Four>(&o, &inv, bound);
             mask &= f.lanes(g);
             while mask != 0 {
                 let l = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 if t[l] <= bound {
-                    f.object_closest::<K>(4 * g + l, ray, &r, &mut c);
+                    f.object_closest::<P>(4 * g + l, ray, &r, &mut c);
                     if let Some(h) = c.best {
                         bound = cull_bound(h.t);
                     }
@@ -317,7 +247,7 @@ fn closest<K: Kernel>(f: &Flat, ray: &Ray, t_max: f32) -> Option<Hit> {
     let mut order = [(0f32, 0u32); SORTED_MAX];
     let mut n = 0;
     for (g, bx) in f.boxes.iter().enumerate() {
-        let (mut mask, t) = K::boxes(bx, &o, &inv, bound);
+        let (mut mask, t) = bx.enter::<P::Four>(&o, &inv, bound);
         mask &= f.lanes(g);
         while mask != 0 {
             let l = mask.trailing_zeros() as usize;
@@ -335,7 +265,7 @@ fn closest<K: Kernel>(f: &Flat, ray: &Ray, t_max: f32) -> Option<Hit> {
         if !(t_enter <= bound) {
             break;
         }
-        f.object_closest::<K>(obj as usize, ray, &r, &mut c);
+        f.object_closest::<P>(obj as usize, ray, &r, &mut c);
         if let Some(h) = c.best {
             bound = cull_bound(h.t);
         }
@@ -344,17 +274,17 @@ fn closest<K: Kernel>(f: &Flat, ray: &Ray, t_max: f32) -> Option<Hit> {
 }
 
 #[inline(always)]
-fn occluded<K: Kernel>(f: &Flat, ray: &Ray, t_max: f32) -> bool {
+fn occluded<P: Path>(f: &Flat, ray: &Ray, t_max: f32) -> bool {
     let r = RayLanes::new(ray);
     let (o, inv) = (ray.origin.to_array(), ray.inv_dir.to_array());
     let bound = cull_bound(t_max);
     for (g, bx) in f.boxes.iter().enumerate() {
-        let (mut mask, _) = K::boxes(bx, &o, &inv, bound);
+        let (mut mask, _) = bx.enter::<P::Four>(&o, &inv, bound);
         mask &= f.lanes(g);
         while mask != 0 {
             let l = mask.trailing_zeros() as usize;
             mask &= mask - 1;
-            if f.object_occluded::<K>(4 * g + l, ray, &r, t_max) {
+            if f.object_occluded::<P>(4 * g + l, ray, &r, t_max) {
                 return true;
             }
         }

@@ -5,7 +5,7 @@
 //! - [`AccelKind::Flat`]: the scene's objects (the Cornell room, each block, a mesh), each with
 //!   a bounding box; a ray is tested against the triangles of every object whose box it meets.
 //!   Fastest for a few dozen triangles.
-//! - [`AccelKind::Bvh`]: a bounding volume hierarchy ([`crate::accel::bvh`]).
+//! - [`AccelKind::Bvh`]: a bounding volume hierarchy (`bvh.rs`).
 //!
 //! Both answer exactly as testing every triangle would: the closest hit is the one with the
 //! smallest `t`, ties going to the lowest triangle index, and a shadow ray is occluded when any
@@ -15,9 +15,9 @@
 //! Both test triangles four or eight at a time ([`tri4`]) on the widest SIMD path the CPU has
 //! ([`Isa::detect`]); every path gives the same hits, bit for bit.
 
-pub mod box4;
-pub mod box8;
-pub mod bvh;
+mod box4;
+mod box8;
+mod bvh;
 mod flat;
 mod hit;
 pub mod shadow;
@@ -32,6 +32,7 @@ use flat::Flat;
 
 pub use crate::geometry::TILE_RAYS;
 pub use crate::simd::Isa;
+pub use bvh::MAX_DEPTH;
 pub(crate) use bvh::prefetch_value;
 pub use flat::TileCache;
 pub use hit::{CULL_SLACK, Hit, cull_bound, shrunk_t_max};
@@ -202,9 +203,9 @@ impl Accel {
     }
 
     /// [`Accel::intersect_tile`], the hits as lanes: ray `i`'s is lane `i % 8` of
-    /// `best[i / 8]` (lanes past the tile's rays are not to be read). The flat list on AVX2
-    /// and AVX-512 leaves them there as its kernel makes them; other structures and paths are
-    /// asked for [`Hit`]s, which are then put in lanes. The same hits either way.
+    /// `best[i / 8]` (lanes past the tile's rays are not to be read). The flat list leaves
+    /// them there as its kernel makes them; the BVH is asked for [`Hit`]s, which are then put
+    /// in lanes. The same hits either way.
     pub fn intersect_tile_best(
         &self,
         tile: &RayTile,
@@ -212,9 +213,8 @@ impl Accel {
         best: &mut [tri4::Best8; TILE_RAYS / 8],
         cache: &mut TileCache,
     ) {
-        #[cfg(target_arch = "x86_64")]
-        if let (Structure::Flat(flat), Isa::Avx2 | Isa::Avx512) = (&self.structure, self.isa) {
-            flat.intersect_tile_best_wide(self.isa, tile, t_max, best, cache);
+        if let Structure::Flat(flat) = &self.structure {
+            flat.intersect_tile_best(self.isa, tile, t_max, best, cache);
             return;
         }
         let mut hits = [None; TILE_RAYS];

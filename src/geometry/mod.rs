@@ -17,11 +17,14 @@ mod triangle;
 mod watertight;
 
 pub use aabb::Aabb;
+pub(crate) use aabb::enter_boxes;
 pub use float::{gamma, next_float_down, next_float_up};
 pub use offset::{hit_point, offset_ray_origin};
 pub use ray::{Ray, RayFrame};
+pub(crate) use ray::{axes_of, main_axis, shear_of};
 pub use ray_tile::{RayTile, TILE_RAYS};
 pub use triangle::{DegenerateTriangle, Triangle};
+pub(crate) use watertight::watertight_lanes;
 pub use watertight::{TriHit, intersect_watertight, t_error_bound};
 
 #[cfg(test)]

@@ -3,6 +3,8 @@
 
 use glam::Vec3;
 
+use crate::simd::Lanes;
+
 /// A ray `origin + t·dir`, with the per-ray constants of the watertight test precomputed.
 ///
 /// `dir` need not be normalised: `t` is measured in units of `dir`.
@@ -40,20 +42,17 @@ impl Ray {
         debug_assert!(
             inv_dir.to_array().map(f32::to_bits) == dir.recip().to_array().map(f32::to_bits)
         );
-        let a = dir.abs();
-        let kz = if a.x > a.y {
-            if a.x > a.z { 0 } else { 2 }
-        } else if a.y > a.z {
+        let d = dir.to_array();
+        let (kz0, kz1) = main_axis::<f32>(d);
+        let kz = if kz0 {
+            0
+        } else if kz1 {
             1
         } else {
             2
         };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if dir[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let sz = inv_dir[kz];
+        let [kx, ky, kz] = axes_of(kz, dir[kz] < 0.0);
+        let [sx, sy, sz] = shear_of::<f32>(d, [kx, ky, kz], inv_dir[kz]);
         Ray {
             origin,
             dir,
@@ -61,8 +60,8 @@ impl Ray {
             kx,
             ky,
             kz,
-            sx: -dir[kx] * sz,
-            sy: -dir[ky] * sz,
+            sx,
+            sy,
             sz,
         }
     }
@@ -150,4 +149,31 @@ impl RayFrame {
             (x[0] * y[1] - y[0] * x[1]) as f32,
         ]
     }
+}
+
+/// The watertight test's main axis `kz` of each lane's direction `d`: the axis along which it
+/// is largest in magnitude, the first one on ties. As masks: the lanes where `kz` is 0, those
+/// where it is 1 (else it is 2).
+#[inline(always)]
+pub(crate) fn main_axis<L: Lanes>(d: [L; 3]) -> (L::Mask, L::Mask) {
+    let a = [d[0].abs(), d[1].abs(), d[2].abs()];
+    let (xy, xz, yz) = (a[0].gt(a[1]), a[0].gt(a[2]), a[1].gt(a[2]));
+    (L::and(xy, xz), L::andnot(xy, yz))
+}
+
+/// The axes `[kx, ky, kz]` for main axis `kz` ([`main_axis`]): `kx` and `ky` follow it
+/// cyclically, swapped when the direction is `negative` along `kz`, so that a triangle's
+/// winding is kept.
+#[inline(always)]
+pub(crate) fn axes_of(kz: usize, negative: bool) -> [usize; 3] {
+    let kx = (kz + 1) % 3;
+    let ky = (kx + 1) % 3;
+    if negative { [ky, kx, kz] } else { [kx, ky, kz] }
+}
+
+/// The shear `[sx, sy, sz]` that maps each lane's direction `d` (axes `[kx, ky, kz]`) onto
+/// its `kz` axis: `sz = 1/d[kz]` (given: `inv_kz`), `sx = −d[kx]·sz`, `sy = −d[ky]·sz`.
+#[inline(always)]
+pub(crate) fn shear_of<L: Lanes>(d: [L; 3], [kx, ky, _]: [usize; 3], inv_kz: L) -> [L; 3] {
+    [d[kx].neg().mul(inv_kz), d[ky].neg().mul(inv_kz), inv_kz]
 }

@@ -15,7 +15,7 @@ pub const TILE_RAYS: usize = 64;
 /// Ray `i` is `Ray::new(origin, dir(i))`, bit for bit ([`RayTile::ray`]); its shear
 /// (`shear_lanes()[k][i]`, `k` = `sx`, `sy`, `sz`) is that ray's [`Ray::shear`] when every ray
 /// shares one axis order ([`RayTile::axes`] is `Some`), and meaningless otherwise. Lanes from
-/// `len` up to the next multiple of 8 repeat ray `len − 1`, so every lane of a packet of eight
+/// `len` up to the next multiple of 16 repeat ray `len − 1`, so every lane of a packet of eight
 /// is a ray of the tile (inside its box of shears).
 #[derive(Clone, Debug)]
 #[repr(C, align(32))]
@@ -86,7 +86,7 @@ impl RayTile {
         tile
     }
 
-    /// Repeats ray `len − 1` in the lanes up to the next multiple of 8.
+    /// Repeats ray `len − 1` in the lanes up to the next multiple of 16 (the widest lanes).
     pub(crate) fn pad(&mut self) {
         let n = self.len;
         if n == 0 {
@@ -94,7 +94,7 @@ impl RayTile {
         }
         for row in self.dir.iter_mut().chain(self.shear.iter_mut()) {
             let last = row[n - 1];
-            row[n..n.next_multiple_of(8)].fill(last);
+            row[n..n.next_multiple_of(16)].fill(last);
         }
     }
 

@@ -1,9 +1,13 @@
-//! The watertight ray/triangle test and its bound on `t`'s rounding error.
+//! The watertight ray/triangle test and its bound on `t`'s rounding error, written once for
+//! any number of lanes ([`watertight_lanes`]): [`intersect_watertight`] is its one-lane form,
+//! the SIMD kernels (`accel::tri4`) its four-, eight- and sixteen-lane forms, so every path
+//! computes the same bits by construction.
 
 use glam::Vec3;
 
 use super::float::gamma;
 use super::ray::{Ray, RayFrame};
+use crate::simd::Lanes;
 
 /// A ray/triangle hit: distance and barycentric weights of the three vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -16,44 +20,241 @@ pub struct TriHit {
 
 /// The watertight ray/triangle test. Two-sided. Returns `None` for a miss, for a hit at or
 /// beyond `t_max`, and for a hit whose `t` is within its own rounding error of zero
-/// ([`t_error_bound`]).
-///
-/// The SIMD kernels (`accel/tri4/x86.rs`) repeat this test and [`t_error_bound`] operation for
-/// operation, in this order: a change here must be made there too (`tests/simd_kernels.rs`
-/// holds them to each other bit for bit).
+/// ([`t_error_bound`]). The one-lane form of [`watertight_lanes`], with its edge functions
+/// redone in `f64` where one rounds to zero ([`RayFrame::edge_functions`]).
 #[inline]
 pub fn intersect_watertight(ray: &Ray, v: &[Vec3; 3], t_max: f32) -> Option<TriHit> {
-    let frame = ray.frame(v);
-    let e = frame.edge_functions();
-    if (e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0) && (e[0] > 0.0 || e[1] > 0.0 || e[2] > 0.0) {
-        return None;
+    let [kx, ky, kz] = ray.axes();
+    let rel = v.map(|v| {
+        let d = v - ray.origin;
+        [d[kx], d[ky], d[kz]]
+    });
+    // `watertight_lanes`, but for its edge functions: redone in `f64` where one rounds to 0.
+    let s = Sheared::new(rel, ray.shear());
+    let f = s.accept(RayFrame::from(&s).edge_functions(), false, t_max, false);
+    (f.mask != 0).then_some(TriHit { t: f.t, b: f.b })
+}
+
+/// What [`watertight_lanes`] finds, lane by lane.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Found<L: Lanes> {
+    /// Bit `i` set: lane `i` is hit, at `t` with barycentrics `b` (meaningless elsewhere).
+    pub mask: u32,
+    /// Bit `i` set: an edge function of lane `i` rounded to 0, so the scalar test redoes it in
+    /// `f64` ([`intersect_watertight`]); nothing else is said about the lane.
+    pub redo: u32,
+    /// The hit lanes as a mask.
+    pub accepted: L::Mask,
+    /// Each hit lane's `t`.
+    pub t: L,
+    /// Each hit lane's barycentric weights of `v0`, `v1`, `v2`.
+    pub b: [L; 3],
+}
+
+/// The watertight test lane by lane: each lane's triangle relative to its ray's origin, in the
+/// ray's axis order (`rel[vertex] = [a, b, z]`), its ray's shear `[sx, sy, sz]` and `t_max`.
+///
+/// With `sure` true, the caller has proven that every lane which passes the sign and range
+/// tests also passes [`t_error_bound`]'s two (the determinant's sign is certain, `t` is beyond
+/// its error bound): they are not computed (debug builds compute them and assert it).
+#[inline(always)]
+pub(crate) fn watertight_lanes<L: Lanes>(
+    rel: [[L; 3]; 3],
+    shear: [L; 3],
+    t_max: L,
+    sure: bool,
+) -> Found<L> {
+    let s = Sheared::new(rel, shear);
+    let e = [s.p[0].sub(s.p[1]), s.p[2].sub(s.p[3]), s.p[4].sub(s.p[5])];
+    let zero = L::splat(0.0);
+    let any_zero = L::or(L::or(e[0].eq(zero), e[1].eq(zero)), e[2].eq(zero));
+    s.accept(e, any_zero, t_max, sure)
+}
+
+/// A triangle sheared into a ray's frame, lane by lane: the vertices' `x`, `y` (the ray runs
+/// along `z`), the unscaled depths `z`, the edge functions' products `p` and the shear.
+struct Sheared<L> {
+    x: [L; 3],
+    y: [L; 3],
+    z: [L; 3],
+    /// `x₁y₂, y₁x₂, x₂y₀, y₂x₀, x₀y₁, y₀x₁`: edge function `i` is `p[2i] − p[2i + 1]`.
+    p: [L; 6],
+    shear: [L; 3],
+}
+
+impl<L: Lanes> Sheared<L> {
+    #[inline(always)]
+    fn new(rel: [[L; 3]; 3], shear: [L; 3]) -> Sheared<L> {
+        let [sx, sy, _] = shear;
+        let [[a0, b0, z0], [a1, b1, z1], [a2, b2, z2]] = rel;
+        let x = [a0.add(sx.mul(z0)), a1.add(sx.mul(z1)), a2.add(sx.mul(z2))];
+        let y = [b0.add(sy.mul(z0)), b1.add(sy.mul(z1)), b2.add(sy.mul(z2))];
+        Sheared::of(x, y, [z0, z1, z2], shear)
     }
-    let det = e[0] + e[1] + e[2];
-    if det == 0.0 || det.is_nan() {
-        return None;
+
+    /// From the sheared coordinates.
+    #[inline(always)]
+    fn of(x: [L; 3], y: [L; 3], z: [L; 3], shear: [L; 3]) -> Sheared<L> {
+        Sheared {
+            x,
+            y,
+            z,
+            p: [
+                x[1].mul(y[2]),
+                y[1].mul(x[2]),
+                x[2].mul(y[0]),
+                y[2].mul(x[0]),
+                x[0].mul(y[1]),
+                y[0].mul(x[1]),
+            ],
+            shear,
+        }
     }
-    let z = frame.z.map(|z| ray.sz * z);
-    let t_scaled = e[0] * z[0] + e[1] * z[1] + e[2] * z[2];
-    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
-        return None;
+
+    /// The test from the edge functions `e` on: the sign test, the determinant, the range of
+    /// `t·det`, `t` and (unless `sure`) its error bound. Lanes in `redo` are not accepted.
+    #[inline(always)]
+    fn accept(&self, e: [L; 3], redo: L::Mask, t_max: L, sure: bool) -> Found<L> {
+        let zero = L::splat(0.0);
+        let any_neg = L::or(L::or(e[0].lt(zero), e[1].lt(zero)), e[2].lt(zero));
+        let any_pos = L::or(L::or(e[0].gt(zero), e[1].gt(zero)), e[2].gt(zero));
+        let det = e[0].add(e[1]).add(e[2]);
+        let sz = self.shear[2];
+        let zs = [sz.mul(self.z[0]), sz.mul(self.z[1]), sz.mul(self.z[2])];
+        let t_scaled = e[0].mul(zs[0]).add(e[1].mul(zs[1])).add(e[2].mul(zs[2]));
+        let bound = t_max.mul(det);
+        // Rejected in the scalar order: mixed signs, a zero or NaN det, `t·det` outside
+        // (0, t_max·det] on det's side.
+        let reject = L::or(
+            L::or(
+                L::and(any_neg, any_pos),
+                L::or(det.eq(zero), det.unord(det)),
+            ),
+            L::or(
+                L::and(det.lt(zero), L::or(t_scaled.ge(zero), t_scaled.lt(bound))),
+                L::and(det.gt(zero), L::or(t_scaled.le(zero), t_scaled.gt(bound))),
+            ),
+        );
+        let redo_bits = L::bits(redo);
+        let full = (1u32 << L::N).wrapping_sub(1);
+        if !L::bits(reject) & !redo_bits & full == 0 {
+            return Found {
+                mask: 0,
+                redo: redo_bits,
+                accepted: L::none(),
+                t: zero,
+                b: [zero; 3],
+            };
+        }
+        let inv_det = L::splat(1.0).div(det);
+        let t = t_scaled.mul(inv_det);
+        let fast = L::andnot(L::or(reject, redo), t.lt(t_max));
+        let accepted = if sure && !cfg!(debug_assertions) {
+            fast
+        } else {
+            let (certain, delta_t) = self.error_bound(e, det, zs, t);
+            let full = L::and(fast, L::and(certain, t.gt(delta_t)));
+            debug_assert!(
+                !sure || L::bits(full) == L::bits(fast),
+                "a sure triangle failed the bound"
+            );
+            full
+        };
+        Found {
+            mask: L::bits(accepted),
+            redo: redo_bits,
+            accepted,
+            t,
+            b: [e[0].mul(inv_det), e[1].mul(inv_det), e[2].mul(inv_det)],
+        }
     }
-    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
-        return None;
+
+    /// Edge function `i`'s error (`(j, k)` its other two vertices), from the coordinates'
+    /// errors `dx`, `dy` (step 2 of [`t_error_bound`]'s derivation).
+    #[inline(always)]
+    fn edge_error(&self, i: usize, (j, k): (usize, usize), dx: [L; 3], dy: [L; 3], g2: L) -> L {
+        let (x, y) = (&self.x, &self.y);
+        x[j].abs()
+            .mul(dy[k])
+            .add(y[k].abs().mul(dx[j]))
+            .add(y[j].abs().mul(dx[k]))
+            .add(x[k].abs().mul(dy[j]))
+            .add(g2.mul(self.p[2 * i].abs().add(self.p[2 * i + 1].abs())))
     }
-    let inv_det = 1.0 / det;
-    let t = t_scaled * inv_det;
-    if !(t < t_max) {
-        return None;
+
+    /// [`t_error_bound`] lane by lane: whether the determinant's sign is certain, and the
+    /// bound on `t`'s error (meaningful where it is). `zs` are the depths scaled by `sz`.
+    #[inline(always)]
+    fn error_bound(&self, e: [L; 3], det: L, zs: [L; 3], t: L) -> (L::Mask, L) {
+        let (x, y, z) = (&self.x, &self.y, &self.z);
+        let [sx, sy, _] = self.shear;
+        let (g2, g3, g5) = (L::splat(gamma(2)), L::splat(gamma(3)), L::splat(gamma(5)));
+        let two = L::splat(2.0);
+        let max_zt = zs[0].abs().max(zs[1].abs()).max(zs[2].abs());
+        // Step 1: each sheared coordinate's error.
+        let coord = |c: L, s: L, z: L| coord_error(c, s, z, g5);
+        let dx = [
+            coord(x[0], sx, z[0]),
+            coord(x[1], sx, z[1]),
+            coord(x[2], sx, z[2]),
+        ];
+        let dy = [
+            coord(y[0], sy, z[0]),
+            coord(y[1], sy, z[1]),
+            coord(y[2], sy, z[2]),
+        ];
+        // Step 2: each edge function's, for (j, k) = (1, 2), (2, 0), (0, 1).
+        let ee = [
+            self.edge_error(0, (1, 2), dx, dy, g2),
+            self.edge_error(1, (2, 0), dx, dy, g2),
+            self.edge_error(2, (0, 1), dx, dy, g2),
+        ];
+        // Step 3: the weights' error, over the depths' spread about `t`.
+        let total = ee[0].add(ee[1]).add(ee[2]);
+        let margin = det.abs().sub(total);
+        let certain = margin.gt(L::splat(0.0));
+        let inv = L::splat(1.0).div(det.abs());
+        let g3z = g3.mul(max_zt);
+        let w = [
+            weight_error(ee[0], e[0].mul(inv), total, zs[0].sub(t).abs().add(g3z)),
+            weight_error(ee[1], e[1].mul(inv), total, zs[1].sub(t).abs().add(g3z)),
+            weight_error(ee[2], e[2].mul(inv), total, zs[2].sub(t).abs().add(g3z)),
+        ];
+        let weights_error = w[0].add(w[1]).add(w[2]).div(margin);
+        // Step 4, and the doubling.
+        let delta_t = two.mul(
+            L::splat(2.0 * gamma(3))
+                .mul(max_zt)
+                .add(g3.mul(t))
+                .add(weights_error),
+        );
+        (certain, delta_t)
     }
-    // A `None` bound: the determinant's sign is not certain (the ray lies nearly in the plane).
-    let delta_t = t_error_bound(ray, &frame, e, t)?;
-    if !(t > delta_t) {
-        return None;
+}
+
+/// A sheared coordinate's error, `γ₅·(|c| + 2|s·|z||)` (step 1 of [`t_error_bound`]'s
+/// derivation). The kernels' helpers are functions, not closures, so that they are sure to
+/// inline: code left out of line would lose the path's target features.
+#[inline(always)]
+fn coord_error<L: Lanes>(c: L, s: L, z: L, g5: L) -> L {
+    g5.mul(c.abs().add(L::splat(2.0).mul(s.mul(z.abs()).abs())))
+}
+
+/// A weight's error times its depth's spread about `t`: `(δeᵢ + |wᵢ|·Σδe)·spreadᵢ` (step 3),
+/// `w` the weight `eᵢ/|det|`.
+#[inline(always)]
+fn weight_error<L: Lanes>(ee: L, w: L, total: L, spread: L) -> L {
+    ee.add(w.abs().mul(total)).mul(spread)
+}
+
+impl From<&Sheared<f32>> for RayFrame {
+    fn from(s: &Sheared<f32>) -> RayFrame {
+        RayFrame {
+            x: s.x,
+            y: s.y,
+            z: s.z,
+        }
     }
-    Some(TriHit {
-        t,
-        b: [e[0] * inv_det, e[1] * inv_det, e[2] * inv_det],
-    })
 }
 
 /// A conservative bound on the rounding error of the `t` that [`intersect_watertight`] computes
@@ -101,57 +302,10 @@ pub fn intersect_watertight(ray: &Ray, v: &[Vec3; 3], t_max: f32) -> Option<TriH
 /// Here each edge gets its own error from its own operands, in the units the arithmetic really
 /// uses, and the weight error is multiplied by the spread. All of it is `f32` and only runs for
 /// rays that pass the edge tests, so the kernel's cost is unchanged for misses.
-#[inline]
 pub fn t_error_bound(ray: &Ray, frame: &RayFrame, e: [f32; 3], t: f32) -> Option<f32> {
-    let z = frame.z.map(|z| ray.sz * z);
-    let max_zt = z[0].abs().max(z[1].abs()).max(z[2].abs());
+    let s = Sheared::of(frame.x, frame.y, frame.z, ray.shear());
     let det = e[0] + e[1] + e[2];
-    let edge = EdgeErrors::new(frame.x, frame.y, frame.z.map(f32::abs), (ray.sx, ray.sy));
-    let weights_error = edge.weights(e, det, z.map(|z| (z - t).abs() + gamma(3) * max_zt))?;
-    Some(2.0 * (2.0 * gamma(3) * max_zt + gamma(3) * t + weights_error))
-}
-
-/// Bounds on the rounding error of the watertight test's three edge functions, each from its
-/// own operands (steps 1 and 2 of [`t_error_bound`]'s derivation).
-struct EdgeErrors {
-    e: [f32; 3],
-}
-
-impl EdgeErrors {
-    /// From the sheared vertex coordinates `x`, `y`, the unscaled `|z|` and the shear.
-    #[inline]
-    fn new(x: [f32; 3], y: [f32; 3], z: [f32; 3], (sx, sy): (f32, f32)) -> EdgeErrors {
-        // Written out per index rather than `[0, 1, 2].map(..)`: the same arithmetic, but the
-        // compiler unrolls it (through `map` it kept a loop with `% 3` divisions).
-        let dx = |i: usize| gamma(5) * (x[i].abs() + 2.0 * (sx * z[i]).abs());
-        let dy = |i: usize| gamma(5) * (y[i].abs() + 2.0 * (sy * z[i]).abs());
-        let (dx, dy) = ([dx(0), dx(1), dx(2)], [dy(0), dy(1), dy(2)]);
-        let edge = |j: usize, k: usize| {
-            x[j].abs() * dy[k]
-                + y[k].abs() * dx[j]
-                + y[j].abs() * dx[k]
-                + x[k].abs() * dy[j]
-                + gamma(2) * ((x[j] * y[k]).abs() + (y[j] * x[k]).abs())
-        };
-        EdgeErrors {
-            e: [edge(1, 2), edge(2, 0), edge(0, 1)],
-        }
-    }
-
-    /// How far errors in the weights `eᵢ/det` can move a weighted mean whose terms lie within
-    /// `spread[i]` of it: Σ (δeᵢ + |wᵢ|·Σδe)·spreadᵢ / (|det| − Σδe) (step 3). `None` when the
-    /// determinant is not certain to be non-zero.
-    #[inline]
-    fn weights(&self, e: [f32; 3], det: f32, spread: [f32; 3]) -> Option<f32> {
-        let total = self.e[0] + self.e[1] + self.e[2];
-        let margin = det.abs() - total;
-        if !(margin > 0.0) {
-            return None;
-        }
-        let inv = 1.0 / det.abs();
-        let sum: f32 = (0..3)
-            .map(|i| (self.e[i] + (e[i] * inv).abs() * total) * spread[i])
-            .sum();
-        Some(sum / margin)
-    }
+    let sz = ray.shear()[2];
+    let (certain, delta_t) = s.error_bound(e, det, frame.z.map(|z| sz * z), t);
+    certain.then_some(delta_t)
 }

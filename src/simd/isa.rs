@@ -1,4 +1,4 @@
-//! Which SIMD path the triangle and box kernels take, picked at run time.
+//! Which SIMD path the kernels take, picked at run time.
 
 /// The SIMD instruction set a kernel uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -9,10 +9,10 @@ pub enum Isa {
     Sse2,
     /// Eight lanes, two blocks at a time (x86-64 CPUs from 2013 on; detected at run time).
     Avx2,
-    /// AVX2's path, with sixteen lanes where it pays: a tile's camera rays sixteen at a time,
-    /// the tile's shading compiled for AVX-512, and an anti-aliased sample's random numbers
-    /// eight pixels at a time (AVX-512 F, DQ, VL and BW: x86-64 server CPUs from 2017 on, AMD's
-    /// from Zen 4; detected at run time). The BVH's kernels are AVX2's.
+    /// AVX2's lanes, with sixteen where it pays: a tile's rays sixteen at a time against a
+    /// triangle, the tile's shading compiled for AVX-512, and an anti-aliased sample's random
+    /// numbers eight pixels at a time (AVX-512 F, DQ, VL and BW: x86-64 server CPUs from 2017
+    /// on, AMD's from Zen 4; detected at run time).
     Avx512,
 }
 

@@ -5,7 +5,7 @@
 
 use super::node::{Node, NodePair};
 use crate::accel::box8::{BOX_LANES, Box8};
-use crate::accel::tri4::{LANES, Portable, Tri4};
+use crate::accel::tri4::{LANES, Tri4};
 use crate::geometry::{Aabb, Triangle};
 
 /// Children per node at most. (Four was measured too: see the issue notes.)
@@ -215,35 +215,5 @@ impl TreeStats {
             leaves: all().filter(|n| n.is_leaf()).count(),
             sah_cost,
         }
-    }
-}
-
-/// The wide box test of one SIMD path.
-pub(super) trait WideBoxes {
-    /// [`Box8`]'s slab test on this path.
-    fn enter(b: &Box8, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; WIDTH]);
-}
-
-impl WideBoxes for Portable {
-    #[inline(always)]
-    fn enter(b: &Box8, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; WIDTH]) {
-        b.enter_portable(origin, inv_dir, t_max)
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-impl WideBoxes for crate::accel::tri4::Sse2 {
-    #[inline(always)]
-    fn enter(b: &Box8, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; WIDTH]) {
-        b.enter_sse2(origin, inv_dir, t_max)
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-impl WideBoxes for crate::accel::tri4::Avx2 {
-    #[inline(always)]
-    fn enter(b: &Box8, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; WIDTH]) {
-        // SAFETY: `Avx2` is only instantiated behind a check that the CPU has AVX2.
-        unsafe { b.enter_avx2(origin, inv_dir, t_max) }
     }
 }

@@ -69,8 +69,9 @@ use glam::Vec3;
 
 use super::Flat;
 use crate::accel::hit::Hit;
-use crate::accel::tri4::{Best8, Kernel};
+use crate::accel::tri4::{Best8, BestTile, rays};
 use crate::geometry::{Ray, RayTile, TILE_RAYS, gamma, intersect_watertight};
+use crate::simd::Path;
 
 /// Flat lists of more triangles than this answer tiles one ray at a time: the cull looks at
 /// every triangle once per tile, which pays while triangles are few.
@@ -91,6 +92,9 @@ pub struct TileCache {
     /// The triangles' edge coefficients and margins four at a time, for the SIMD cull
     /// (padding lanes: zero coefficients, NaN margins).
     quads: Vec<CullQuad>,
+    /// The closest hits of the tile being traced (kept here: cleared only as far as a tile
+    /// reaches).
+    best: BestTile,
 }
 
 /// Four triangles' `c`, `p`, `q` and `margin` (as in [`TileTri`]), per edge, lane by lane.
@@ -245,46 +249,6 @@ impl TileCache {
     }
 }
 
-/// How each path culls a tile's triangles.
-pub(super) trait Cull: Kernel {
-    /// [`TileCache::kept`].
-    fn kept(cache: &TileCache, sx: (f64, f64), sy: (f64, f64)) -> u64;
-}
-
-impl Cull for crate::accel::tri4::Portable {
-    #[inline(always)]
-    fn kept(cache: &TileCache, sx: (f64, f64), sy: (f64, f64)) -> u64 {
-        cache.kept(sx, sy)
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-impl Cull for crate::accel::tri4::Sse2 {
-    #[inline(always)]
-    fn kept(cache: &TileCache, sx: (f64, f64), sy: (f64, f64)) -> u64 {
-        cache.kept(sx, sy)
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-impl Cull for crate::accel::tri4::Avx2 {
-    #[inline(always)]
-    fn kept(cache: &TileCache, sx: (f64, f64), sy: (f64, f64)) -> u64 {
-        // SAFETY: `Avx2` is only instantiated behind a check that the CPU has AVX2.
-        unsafe { cache.kept_avx2(sx, sy) }
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-impl Cull for crate::accel::tri4::Avx512 {
-    #[inline(always)]
-    fn kept(cache: &TileCache, sx: (f64, f64), sy: (f64, f64)) -> u64 {
-        // SAFETY: `Avx512` is only instantiated behind a check that the CPU has AVX-512, which
-        // includes AVX2.
-        unsafe { cache.kept_avx2(sx, sy) }
-    }
-}
-
 /// Fills `t`'s edge coefficients and margins for shears up to (`smx`, `smy`) in magnitude.
 fn edges(rel: &[[f32; 3]; 3], smx: f64, smy: f64, t: &mut TileTri) {
     let (g2, g5) = (gamma(2) as f64, gamma(5) as f64);
@@ -388,7 +352,7 @@ const T_SHRINK: f64 = 1.0 / (1u64 << 19) as f64;
 /// it; a tile whose rays do not share their axes, or a list of too many triangles, is
 /// answered one ray at a time by `one`.
 #[inline(always)]
-pub(super) fn intersect_tile<K: Cull>(
+pub(super) fn intersect_tile<P: Path>(
     f: &Flat,
     tile: &RayTile,
     t_max: f32,
@@ -398,16 +362,16 @@ pub(super) fn intersect_tile<K: Cull>(
 ) {
     debug_assert_eq!(tile.len(), hits.len());
     let mut best = [Best8::NONE; TILE_RAYS / 8];
-    intersect_tile_best::<K>(f, tile, t_max, &mut best, cache, one);
-    for (hits, best) in hits.chunks_mut(8).zip(best.iter()) {
-        best.hits_into(hits, K::AVX2);
+    intersect_tile_best::<P>(f, tile, t_max, &mut best, cache, one);
+    for (i, h) in hits.iter_mut().enumerate() {
+        *h = best[i / 8].hit(i % 8);
     }
 }
 
 /// [`intersect_tile`], the hits left in `best` as the kernels make them: ray `i` is lane
 /// `i % 8` of `best[i / 8]` (the rest of `best` is left as it was).
 #[inline(always)]
-pub(super) fn intersect_tile_best<K: Cull>(
+pub(super) fn intersect_tile_best<P: Path>(
     f: &Flat,
     tile: &RayTile,
     t_max: f32,
@@ -441,24 +405,37 @@ pub(super) fn intersect_tile_best<K: Cull>(
     } else {
         (1 << n) - 1
     };
-    let best = &mut best[..packets];
-    best.fill(Best8::NONE);
     // The triangles that survive the cull, in index order.
-    let mut kept = K::kept(cache, sx, sy);
+    #[cfg(target_arch = "x86_64")]
+    let mut kept = if P::AVX {
+        // SAFETY: a path with AVX only runs where the CPU has AVX2 (`Path::AVX`).
+        unsafe { cache.kept_avx2(sx, sy) }
+    } else {
+        cache.kept(sx, sy)
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let mut kept = cache.kept(sx, sy);
     debug_assert_eq!(kept, cache.kept(sx, sy), "the SIMD cull is the scalar one");
     // The rays run along +kz when `sz > 0` (one sign for the whole tile: its axes are shared).
     let ahead = sz0 > 0.0;
+    let TileCache {
+        tris, best: all, ..
+    } = cache;
+    all.clear(n);
     while kept != 0 {
-        let t = &cache.tris[kept.trailing_zeros() as usize];
+        let t = &tris[kept.trailing_zeros() as usize];
         kept &= kept - 1;
         let sure = sure(t, sx, sy, (sz0, sz1), ahead);
-        let mut redo = K::rays(&t.v, &t.rel, tile, t_max, t.id, sure, best) & lanes;
+        let mut redo = rays::<P::Wide>(&t.rel, tile, t_max, t.id, sure, all) & lanes;
         while redo != 0 {
             let l = redo.trailing_zeros() as usize;
             redo &= redo - 1;
             if let Some(h) = intersect_watertight(&tile.ray(l), &t.v, t_max) {
-                best[l / 8].offer(l % 8, h.t, h.b, t.id);
+                all.offer(l, h.t, h.b, t.id);
             }
         }
+    }
+    for (p, best) in best[..packets].iter_mut().enumerate() {
+        all.packet_into(p, best);
     }
 }

@@ -1,39 +1,25 @@
 //! Triangles four at a time: vertices as structure of arrays ([`Tri4`]), and the watertight
-//! test of one ray against four (SSE2) or eight (AVX2) triangles at once.
+//! test of one ray against a block or two ([`block_hits`]), or of one triangle against a
+//! tile's rays ([`rays`]), on any lanes.
 //!
 //! # Bit-identical to the scalar test, by construction
 //!
-//! The SIMD kernels run the whole of [`intersect_watertight`] lane by lane — the sheared
-//! vertices, the edge functions, the sign test, the determinant, the range of `t·det`, `t`,
-//! its error bound ([`crate::geometry::t_error_bound`]) and the barycentrics — with the same
-//! `f32` operations in the same order (no fused multiply-add: the AVX2 path enables `avx2`
-//! only, not `fma`; IEEE division and square-free arithmetic round the same on every path).
-//! So a lane the kernel accepts carries the scalar test's own `t` and barycentrics, bit for
-//! bit, and a lane it rejects is one the scalar test rejects. The one exception is a lane whose
-//! edge function rounds to exactly 0: the scalar test redoes its edges in `f64`, so the kernel
-//! hands that lane back (`redo`) and the search runs [`intersect_watertight`] on it.
-//! `tests/simd_kernels.rs` holds every path to the scalar test over the stability suite's and
-//! the accel tests' rays: accepted lanes, `t` and barycentrics bit for bit.
-//!
-//! # Which path
-//!
-//! [`Isa::detect`] picks the widest the CPU has at run time: AVX2 (eight lanes: two blocks per
-//! step), else SSE2 (four lanes; part of every x86-64), else the portable path, which runs the
-//! scalar test one lane at a time. No `target-cpu` is needed or committed.
+//! Both run [`crate::geometry::watertight_lanes`], of which the scalar test
+//! ([`crate::geometry::intersect_watertight`]) is the one-lane form: so a lane the kernel accepts carries the
+//! scalar test's own `t` and barycentrics, bit for bit, and a lane it rejects is one the
+//! scalar test rejects. The one exception is a lane whose edge function rounds to exactly 0:
+//! the scalar test redoes its edges in `f64`, so the kernel hands that lane back (`redo`) and
+//! the search runs [`crate::geometry::intersect_watertight`] on it.
 
 use glam::Vec3;
 
-use super::box4::Box4;
 use super::hit::Hit;
-use crate::geometry::{Ray, RayTile};
-use crate::simd::Isa;
+use crate::geometry::{Ray, RayTile, TILE_RAYS, watertight_lanes};
+use crate::simd::{Isa, Kernel, Lanes, Path};
 
-mod portable;
 mod search;
 #[cfg(target_arch = "x86_64")]
 pub mod shadow;
-#[cfg(target_arch = "x86_64")]
-mod x86;
 
 pub(crate) use search::{Closest, blocks_closest, blocks_occluded};
 
@@ -136,7 +122,7 @@ impl RayLanes {
 #[derive(Clone, Copy, Debug)]
 pub struct Hits {
     /// Bit `i` set: lane `i` is hit, at `t[i]` with barycentrics `b[..][i]`, exactly as
-    /// [`intersect_watertight`] computes them.
+    /// [`crate::geometry::intersect_watertight`] computes them.
     pub mask: u32,
     /// Bit `i` set: lane `i`'s edge function rounded to 0, so the scalar test redoes it in
     /// `f64`; the kernel says nothing else about it.
@@ -202,46 +188,6 @@ impl Best8 {
         id: [u32::MAX; 2 * LANES],
     };
 
-    /// Takes `(t, b)` on triangle `id` for lane `l` if it is nearer than the lane's best.
-    /// Triangles are offered in increasing order, so a tie keeps the lower index.
-    #[inline]
-    pub fn offer(&mut self, l: usize, t: f32, b: [f32; 3], id: u32) {
-        if t < self.t[l] {
-            self.t[l] = t;
-            for (row, w) in self.b.iter_mut().zip(b) {
-                row[l] = w;
-            }
-            self.id[l] = id;
-        }
-    }
-
-    /// The first `out.len()` (at most 8) lanes' closest hits into `out`: each [`Best8::hit`],
-    /// with AVX2 (where `avx2`) gathered lane by lane by a transposition.
-    #[inline(always)]
-    pub(crate) fn hits_into(&self, out: &mut [Option<Hit>], avx2: bool) {
-        #[cfg(target_arch = "x86_64")]
-        if avx2 {
-            // SAFETY: the caller passes `avx2` only where the CPU has AVX2.
-            let q = unsafe { x86::best_lanes_avx2(self) };
-            for ((h, &id), &[t, b0, b1, b2]) in out.iter_mut().zip(&self.id).zip(&q) {
-                *h = if id == u32::MAX {
-                    None
-                } else {
-                    Some(Hit {
-                        t,
-                        b: [b0, b1, b2],
-                        triangle: id,
-                    })
-                };
-            }
-            return;
-        }
-        let _ = avx2;
-        for (l, h) in out.iter_mut().enumerate() {
-            *h = self.hit(l);
-        }
-    }
-
     /// Makes lane `l`'s closest hit `hit` (none: no hit).
     #[inline]
     pub fn set(&mut self, l: usize, hit: Option<Hit>) {
@@ -286,258 +232,202 @@ impl Best8 {
     }
 }
 
-/// How a traversal tests blocks: one of the three paths, chosen by the type.
-pub(crate) trait Kernel {
-    /// Whether this is the AVX2 path (its helpers may use AVX2).
-    const AVX2: bool = false;
-    /// The hits in one block: `(mask, redo)` as in [`Hits`]; the hit lanes' `t` and
-    /// barycentrics into `out` (lanes 0-3).
-    fn one(block: &Tri4, ray: &Ray, r: &RayLanes, t_max: f32, out: &mut LaneHits) -> (u32, u32);
-    /// The hits in two blocks (lanes 4-7 from `b`), as [`Kernel::one`].
-    fn two(
-        a: &Tri4,
-        b: &Tri4,
-        ray: &Ray,
-        r: &RayLanes,
-        t_max: f32,
-        out: &mut LaneHits,
-    ) -> (u32, u32);
-    /// Which of four boxes the ray meets before `t_max`, and where it enters them.
-    fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]);
-    /// Triangle `id` (vertices `v`; `rel` relative to the rays' common origin in their axis
-    /// order) against the rays of `tile` (which share their axes) eight at a time, folded into
-    /// `best` (eight rays each, as many as the tile has packets of eight). Returns the rays
-    /// the caller must test with the scalar test (its `f64` redo); bits from `tile.len()` on
-    /// are meaningless.
-    ///
-    /// `sure`: the caller has proven that every ray of the tile that passes the test's sign
-    /// and range checks also passes its error-bound checks (`flat/tile.rs`), which the SIMD
-    /// paths then skip.
-    fn rays(
-        v: &[Vec3; 3],
-        rel: &[[f32; 3]; 3],
-        tile: &RayTile,
-        t_max: f32,
-        id: u32,
-        sure: bool,
-        best: &mut [Best8],
-    ) -> u64;
+/// The closest hits so far of a tile's rays, lane by lane (`t` ∞ and id `u32::MAX`'s bits for
+/// none yet): what [`rays`] folds each triangle's hits into, as wide as the path goes.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(crate) struct BestTile {
+    t: [f32; TILE_RAYS],
+    b: [[f32; TILE_RAYS]; 3],
+    /// Each lane's triangle, as the bits of an `f32` (so that the fold moves it as it moves
+    /// the rest).
+    id: [f32; TILE_RAYS],
 }
 
-/// The portable path.
-pub(crate) struct Portable;
+impl BestTile {
+    /// No hit yet.
+    pub const NONE: BestTile = BestTile {
+        t: [f32::INFINITY; TILE_RAYS],
+        b: [[0.0; TILE_RAYS]; 3],
+        id: [f32::from_bits(u32::MAX); TILE_RAYS],
+    };
 
-impl Kernel for Portable {
+    /// Takes `(t, b)` on triangle `id` for ray `l` if it is nearer than the ray's best.
+    /// Triangles are offered in increasing order, so a tie keeps the lower index.
     #[inline(always)]
-    fn one(block: &Tri4, ray: &Ray, _: &RayLanes, t_max: f32, out: &mut LaneHits) -> (u32, u32) {
-        portable::hits(block, ray, t_max, out, 0)
+    pub fn offer(&mut self, l: usize, t: f32, b: [f32; 3], id: u32) {
+        self.fold::<f32>(l, t < self.t[l], t, b, id);
     }
+
+    /// The fold into the nearest hit, `L::N` rays from `at` at once: the lanes in `hit` whose
+    /// `t` is below their best so far take `t`, `b` and triangle `id`.
     #[inline(always)]
-    fn two(
-        a: &Tri4,
-        b: &Tri4,
-        ray: &Ray,
-        _: &RayLanes,
-        t_max: f32,
-        out: &mut LaneHits,
-    ) -> (u32, u32) {
-        let (m0, r0) = portable::hits(a, ray, t_max, out, 0);
-        let (m1, r1) = portable::hits(b, ray, t_max, out, LANES);
-        (m0 | m1 << LANES, r0 | r1 << LANES)
+    fn fold<L: Lanes>(&mut self, at: usize, hit: L::Mask, t: L, b: [L; 3], id: u32) {
+        let best_t = L::load(&self.t[at..]);
+        let take = L::and(hit, t.lt(best_t));
+        L::select(take, best_t, t).store(&mut self.t[at..]);
+        for (k, w) in b.into_iter().enumerate() {
+            let row = &mut self.b[k][at..];
+            L::select(take, L::load(row), w).store(row);
+        }
+        let ids = L::load(&self.id[at..]);
+        L::select(take, ids, L::splat(f32::from_bits(id))).store(&mut self.id[at..]);
     }
+
+    /// Makes rays `0..n` (rounded up to the widest lanes, 16) have no hit yet.
     #[inline(always)]
-    fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
-        b.enter_portable(origin, inv_dir, t_max)
+    pub fn clear(&mut self, n: usize) {
+        let n = n.next_multiple_of(16).min(TILE_RAYS);
+        self.t[..n].fill(f32::INFINITY);
+        for row in &mut self.b {
+            row[..n].fill(0.0);
+        }
+        self.id[..n].fill(f32::from_bits(u32::MAX));
     }
+
+    /// Rays `8·p..8·p + 8` into `out`.
     #[inline(always)]
-    fn rays(
-        v: &[Vec3; 3],
-        _: &[[f32; 3]; 3],
-        tile: &RayTile,
-        t_max: f32,
-        id: u32,
-        _: bool,
-        best: &mut [Best8],
-    ) -> u64 {
-        for l in 0..tile.len() {
-            if let Some(h) = crate::geometry::intersect_watertight(&tile.ray(l), v, t_max) {
-                best[l / 8].offer(l % 8, h.t, h.b, id);
+    pub fn packet_into(&self, p: usize, out: &mut Best8) {
+        let at = 8 * p..8 * p + 8;
+        out.t.copy_from_slice(&self.t[at.clone()]);
+        for (row, b) in out.b.iter_mut().zip(&self.b) {
+            row.copy_from_slice(&b[at.clone()]);
+        }
+        for (id, bits) in out.id.iter_mut().zip(&self.id[at]) {
+            *id = bits.to_bits();
+        }
+    }
+}
+
+impl Default for BestTile {
+    fn default() -> BestTile {
+        BestTile::NONE
+    }
+}
+
+/// The hits of `r` in `blocks` (one or two: lanes 4-7 from the second), `L::N` lanes at a
+/// time: `(mask, redo)` as in [`Hits`], and, for lanes some of which are hit, their `t` and
+/// barycentrics into `out` (written only then, and meaningful only in hit lanes). The masks
+/// are returned in registers, so that a traversal that inlines this tests them without a round
+/// trip through memory, and an any-hit query, which never reads `out`, drops the stores.
+#[inline(always)]
+pub(crate) fn block_hits<L: Lanes>(
+    blocks: &[Tri4],
+    r: &RayLanes,
+    t_max: f32,
+    out: &mut LaneHits,
+) -> (u32, u32) {
+    let origin = splat3(&r.origin);
+    let shear = splat3(&r.shear);
+    let (mut mask, mut redo) = (0, 0);
+    for at in (0..LANES * blocks.len()).step_by(L::N) {
+        let rel = [
+            vertex(blocks, at, 0, r.axes, origin),
+            vertex(blocks, at, 1, r.axes, origin),
+            vertex(blocks, at, 2, r.axes, origin),
+        ];
+        let f = watertight_lanes(rel, shear, L::splat(t_max), false);
+        if f.mask != 0 {
+            f.t.store(&mut out.t[at..]);
+            for (k, b) in f.b.into_iter().enumerate() {
+                b.store(&mut out.b[k][at..]);
             }
         }
-        0
+        mask |= f.mask << at;
+        redo |= f.redo << at;
     }
+    (mask, redo)
 }
 
-/// The SSE2 path.
-#[cfg(target_arch = "x86_64")]
-pub(crate) struct Sse2;
-
-#[cfg(target_arch = "x86_64")]
-impl Kernel for Sse2 {
-    #[inline(always)]
-    fn one(block: &Tri4, _: &Ray, r: &RayLanes, t_max: f32, out: &mut LaneHits) -> (u32, u32) {
-        x86::hits_sse2(block, r, t_max, out, 0)
-    }
-    #[inline(always)]
-    fn two(
-        a: &Tri4,
-        b: &Tri4,
-        _: &Ray,
-        r: &RayLanes,
-        t_max: f32,
-        out: &mut LaneHits,
-    ) -> (u32, u32) {
-        let (m0, r0) = x86::hits_sse2(a, r, t_max, out, 0);
-        let (m1, r1) = x86::hits_sse2(b, r, t_max, out, LANES);
-        (m0 | m1 << LANES, r0 | r1 << LANES)
-    }
-    #[inline(always)]
-    fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
-        b.enter_sse2(origin, inv_dir, t_max)
-    }
-    #[inline(always)]
-    fn rays(
-        _: &[Vec3; 3],
-        rel: &[[f32; 3]; 3],
-        tile: &RayTile,
-        t_max: f32,
-        id: u32,
-        sure: bool,
-        best: &mut [Best8],
-    ) -> u64 {
-        x86::rays_sse2(rel, tile, t_max, id, sure, best)
-    }
+/// Vertex `i` of `blocks`' lanes `at..at + L::N`, relative to `origin`, in the axis order
+/// `[kx, ky, kz]` (the kernels' helpers are functions, not closures, so that they are sure to
+/// inline: code left out of line would lose the path's target features).
+#[inline(always)]
+fn vertex<L: Lanes>(
+    blocks: &[Tri4],
+    at: usize,
+    i: usize,
+    [kx, ky, kz]: [usize; 3],
+    origin: [L; 3],
+) -> [L; 3] {
+    let v = |axis: usize| L::load_fours(|k| &blocks[at / LANES + k].v[i][axis], at);
+    [
+        v(kx).sub(origin[0]),
+        v(ky).sub(origin[1]),
+        v(kz).sub(origin[2]),
+    ]
 }
 
-/// The AVX2 path. Only used inside functions compiled with AVX2 enabled, which are only called
-/// once [`Isa::Avx2`] is known to be available.
-#[cfg(target_arch = "x86_64")]
-pub(crate) struct Avx2;
-
-#[cfg(target_arch = "x86_64")]
-impl Kernel for Avx2 {
-    const AVX2: bool = true;
-    #[inline(always)]
-    fn one(block: &Tri4, _: &Ray, r: &RayLanes, t_max: f32, out: &mut LaneHits) -> (u32, u32) {
-        // The SSE2 kernel, VEX-encoded where it inlines (functions compiled for AVX2).
-        x86::hits_sse2(block, r, t_max, out, 0)
-    }
-    #[inline(always)]
-    fn two(
-        a: &Tri4,
-        b: &Tri4,
-        _: &Ray,
-        r: &RayLanes,
-        t_max: f32,
-        out: &mut LaneHits,
-    ) -> (u32, u32) {
-        // SAFETY: `Avx2` is only instantiated behind a check that the CPU has AVX2, inside
-        // functions compiled for it (so the kernel inlines).
-        unsafe { x86::hits2_avx2(a, b, r, t_max, out) }
-    }
-    #[inline(always)]
-    fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
-        b.enter_sse2(origin, inv_dir, t_max)
-    }
-    #[inline(always)]
-    fn rays(
-        _: &[Vec3; 3],
-        rel: &[[f32; 3]; 3],
-        tile: &RayTile,
-        t_max: f32,
-        id: u32,
-        sure: bool,
-        best: &mut [Best8],
-    ) -> u64 {
-        // SAFETY: `Avx2` is only instantiated behind a check that the CPU has AVX2.
-        unsafe { x86::rays_avx2(rel, tile, t_max, id, sure, best) }
-    }
+/// Each of `v` in every lane.
+#[inline(always)]
+fn splat3<L: Lanes>(v: &[f32; 3]) -> [L; 3] {
+    [L::splat(v[0]), L::splat(v[1]), L::splat(v[2])]
 }
 
-/// The AVX-512 path: AVX2's kernels but for a tile's rays, sixteen lanes at a time. Only used
-/// inside functions compiled with AVX-512 enabled, which are only called once [`Isa::Avx512`]
-/// is known to be available.
-#[cfg(target_arch = "x86_64")]
-pub(crate) struct Avx512;
-
-#[cfg(target_arch = "x86_64")]
-impl Kernel for Avx512 {
-    const AVX2: bool = true;
-    #[inline(always)]
-    fn one(block: &Tri4, ray: &Ray, r: &RayLanes, t_max: f32, out: &mut LaneHits) -> (u32, u32) {
-        Avx2::one(block, ray, r, t_max, out)
+/// One triangle (`rel`: its vertices relative to the rays' common origin, in their axis
+/// order) against the rays of `tile` (which share their axes) `L::N` at a time, folded into
+/// `best` (lanes that hit it nearer than their best so far take it, as `id`). Returns the rays
+/// the caller must test with the scalar test (its `f64` redo); bits from `tile.len()` on are
+/// meaningless, as are `best`'s lanes from there.
+///
+/// `sure`: the caller has proven that every ray of the tile that passes the test's sign
+/// and range checks also passes its error-bound checks (`flat/tile.rs`), which are then
+/// skipped.
+#[inline(always)]
+pub(crate) fn rays<L: Lanes>(
+    rel: &[[f32; 3]; 3],
+    tile: &RayTile,
+    t_max: f32,
+    id: u32,
+    sure: bool,
+    best: &mut BestTile,
+) -> u64 {
+    let rel = [splat3(&rel[0]), splat3(&rel[1]), splat3(&rel[2])];
+    let t_max = L::splat(t_max);
+    let mut redo = 0;
+    // The tile's lanes are padded to a multiple of 16 with its last ray.
+    for at in (0..tile.len()).step_by(L::N) {
+        let s = &tile.shear;
+        let shear = [
+            L::load(&s[0][at..]),
+            L::load(&s[1][at..]),
+            L::load(&s[2][at..]),
+        ];
+        let f = watertight_lanes(rel, shear, t_max, sure);
+        redo |= u64::from(f.redo) << at;
+        if f.mask != 0 {
+            best.fold(at, f.accepted, f.t, f.b, id);
+        }
     }
-    #[inline(always)]
-    fn two(
-        a: &Tri4,
-        b: &Tri4,
-        ray: &Ray,
-        r: &RayLanes,
-        t_max: f32,
-        out: &mut LaneHits,
-    ) -> (u32, u32) {
-        Avx2::two(a, b, ray, r, t_max, out)
-    }
-    #[inline(always)]
-    fn boxes(b: &Box4, origin: &[f32; 3], inv_dir: &[f32; 3], t_max: f32) -> (u32, [f32; 4]) {
-        Avx2::boxes(b, origin, inv_dir, t_max)
-    }
-    #[inline(always)]
-    fn rays(
-        _: &[Vec3; 3],
-        rel: &[[f32; 3]; 3],
-        tile: &RayTile,
-        t_max: f32,
-        id: u32,
-        sure: bool,
-        best: &mut [Best8],
-    ) -> u64 {
-        // SAFETY: `Avx512` is only instantiated behind a check that the CPU has AVX-512.
-        unsafe { x86::rays_avx512(rel, tile, t_max, id, sure, best) }
-    }
+    redo
 }
 
-/// The hits of `ray` in one block on path `isa` (for tests and tools; traversals call the
-/// kernels directly). `isa` must be available.
+/// The hits of `ray` in one block on path `isa` (for tests and tools; traversals call
+/// [`block_hits`] on their own path). `isa` must be available.
 pub fn hits(isa: Isa, block: &Tri4, ray: &Ray, t_max: f32) -> Hits {
-    assert!(
-        isa.available(),
-        "{} is not available on this CPU",
-        isa.name()
-    );
-    let r = RayLanes::new(ray);
-    let mut out = LaneHits::ZERO;
-    let masks = match isa {
-        Isa::Portable => Portable::one(block, ray, &r, t_max, &mut out),
-        #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 => Sse2::one(block, ray, &r, t_max, &mut out),
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: checked available above.
-        Isa::Avx2 | Isa::Avx512 => unsafe { x86::hits_avx2_call(block, &r, t_max, &mut out) },
-        #[cfg(not(target_arch = "x86_64"))]
-        _ => unreachable!(),
-    };
-    Hits::of(masks, &out)
+    isa.run(Blocks(std::slice::from_ref(block), ray, t_max))
 }
 
 /// The hits of `ray` in two blocks on path `isa` (lanes 4-7 from `b`). `isa` must be available.
 pub fn hits2(isa: Isa, a: &Tri4, b: &Tri4, ray: &Ray, t_max: f32) -> Hits {
-    assert!(
-        isa.available(),
-        "{} is not available on this CPU",
-        isa.name()
-    );
-    let r = RayLanes::new(ray);
-    let mut out = LaneHits::ZERO;
-    let masks = match isa {
-        Isa::Portable => Portable::two(a, b, ray, &r, t_max, &mut out),
-        #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 => Sse2::two(a, b, ray, &r, t_max, &mut out),
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: checked available above.
-        Isa::Avx2 | Isa::Avx512 => unsafe { x86::hits2_avx2_call(a, b, &r, t_max, &mut out) },
-        #[cfg(not(target_arch = "x86_64"))]
-        _ => unreachable!(),
-    };
-    Hits::of(masks, &out)
+    isa.run(Blocks(&[*a, *b], ray, t_max))
+}
+
+/// [`hits`] and [`hits2`] as a kernel.
+struct Blocks<'a>(&'a [Tri4], &'a Ray, f32);
+
+impl Kernel for Blocks<'_> {
+    type Output = Hits;
+    #[inline(always)]
+    fn run<P: Path>(self) -> Hits {
+        let Blocks(blocks, ray, t_max) = self;
+        let r = RayLanes::new(ray);
+        let mut out = LaneHits::ZERO;
+        let masks = if blocks.len() == 2 {
+            block_hits::<P::Eight>(blocks, &r, t_max, &mut out)
+        } else {
+            block_hits::<P::Four>(blocks, &r, t_max, &mut out)
+        };
+        Hits::of(masks, &out)
+    }
 }

@@ -3,9 +3,10 @@
 
 use glam::Vec3;
 
-use super::{Kernel, LANES, LaneHits, RayLanes, Tri4};
+use super::{LANES, LaneHits, RayLanes, Tri4, block_hits};
 use crate::accel::hit::{Hit, shrunk_t_max};
 use crate::geometry::{Ray, intersect_watertight};
+use crate::simd::Path;
 
 /// The closest-hit search's state: the best hit so far and the `t_max` a triangle is tested
 /// with (four ULPs above it, see [`shrunk_t_max`]).
@@ -71,7 +72,7 @@ impl Closest {
 /// Folds the closest hit among consecutive `blocks` (whose lanes' scene indices are `ids`) into
 /// `c`: two blocks per step where there are two.
 #[inline(always)]
-pub(crate) fn blocks_closest<K: Kernel>(
+pub(crate) fn blocks_closest<P: Path>(
     blocks: &[Tri4],
     ids: &[u32],
     ray: &Ray,
@@ -82,12 +83,11 @@ pub(crate) fn blocks_closest<K: Kernel>(
     let mut b = 0;
     while b < blocks.len() {
         let (masks, n) = if b + 1 < blocks.len() {
-            (
-                K::two(&blocks[b], &blocks[b + 1], ray, r, c.tri_t_max, &mut h),
-                2,
-            )
+            let two = &blocks[b..b + 2];
+            (block_hits::<P::Eight>(two, r, c.tri_t_max, &mut h), 2)
         } else {
-            (K::one(&blocks[b], ray, r, c.tri_t_max, &mut h), 1)
+            let one = &blocks[b..b + 1];
+            (block_hits::<P::Four>(one, r, c.tri_t_max, &mut h), 1)
         };
         if (masks.0 | masks.1) != 0 {
             c.take(
@@ -104,7 +104,7 @@ pub(crate) fn blocks_closest<K: Kernel>(
 
 /// Whether a triangle of `blocks` has a hit before `t_max`.
 #[inline(always)]
-pub(crate) fn blocks_occluded<K: Kernel>(
+pub(crate) fn blocks_occluded<P: Path>(
     blocks: &[Tri4],
     ray: &Ray,
     r: &RayLanes,
@@ -116,12 +116,11 @@ pub(crate) fn blocks_occluded<K: Kernel>(
     let mut b = 0;
     while b < blocks.len() {
         let ((mask, redo), n) = if b + 1 < blocks.len() {
-            (
-                K::two(&blocks[b], &blocks[b + 1], ray, r, t_max, &mut unused),
-                2,
-            )
+            let two = &blocks[b..b + 2];
+            (block_hits::<P::Eight>(two, r, t_max, &mut unused), 2)
         } else {
-            (K::one(&blocks[b], ray, r, t_max, &mut unused), 1)
+            let one = &blocks[b..b + 1];
+            (block_hits::<P::Four>(one, r, t_max, &mut unused), 1)
         };
         if mask != 0 {
             return true;

@@ -1,13 +1,13 @@
 //! Shadow rays eight at a time: one triangle against eight rays that share their axes but not
 //! their origins (a tile's rays toward a point light), any hit only. Each lane runs the
-//! scalar test's operations (`x86.rs`'s `watertight_lanes`, the kernel of every path)
+//! scalar test's operations ([`crate::geometry::watertight_lanes`], the kernel of every path)
 //! on its own origin and shear, so a lane is reported hit exactly when
 //! [`crate::geometry::intersect_watertight`] accepts it; a lane whose edge function rounds to
 //! 0 is handed back (`redo`) for the scalar test's `f64` edges.
 
 use super::LANES;
-use super::x86::{avx, watertight_lanes};
-use crate::geometry::gamma;
+use crate::geometry::watertight_lanes;
+use crate::simd::{F8, Lanes};
 
 /// Up to eight rays with the same axes (`kx`, `ky`, `kz`), lane by lane: each origin in that
 /// axis order and each shear, as [`crate::geometry::Ray`] holds them.
@@ -41,42 +41,31 @@ pub unsafe fn any_hit8_avx2(v: &[[f32; 4]; 3], rays: &ShadowRays8, t_max: f32) -
 /// The CPU must have AVX2.
 #[inline(always)]
 pub(crate) unsafe fn any_hit8(v: &[[f32; 4]; 3], rays: &ShadowRays8, t_max: f32) -> (u32, u32) {
-    use avx::*;
-    use std::arch::x86_64::*;
-    // SAFETY: the CPU has AVX2 (this function's contract); every load reads a whole
-    // 32-byte-aligned `[f32; 8]`.
     // (No closures: this runs inlined into kernels compiled for AVX2 or AVX-512, and a
     // closure would be compiled on its own, without those features.)
-    unsafe {
-        let [kx, ky, kz] = rays.axes;
-        let ox = _mm256_load_ps(rays.origin[0].as_ptr());
-        let oy = _mm256_load_ps(rays.origin[1].as_ptr());
-        let oz = _mm256_load_ps(rays.origin[2].as_ptr());
-        // `RayFrame`: each vertex relative to each lane's origin, in the axis order.
-        let (a0, b0, z0) = (
-            sub(splat(v[0][kx]), ox),
-            sub(splat(v[0][ky]), oy),
-            sub(splat(v[0][kz]), oz),
-        );
-        let (a1, b1, z1) = (
-            sub(splat(v[1][kx]), ox),
-            sub(splat(v[1][ky]), oy),
-            sub(splat(v[1][kz]), oz),
-        );
-        let (a2, b2, z2) = (
-            sub(splat(v[2][kx]), ox),
-            sub(splat(v[2][ky]), oy),
-            sub(splat(v[2][kz]), oz),
-        );
-        let sx = _mm256_load_ps(rays.shear[0].as_ptr());
-        let sy = _mm256_load_ps(rays.shear[1].as_ptr());
-        let sz = _mm256_load_ps(rays.shear[2].as_ptr());
-        let (hit, redo, ..) = watertight_lanes!(
-            avx,
-            [a0, b0, z0, a1, b1, z1, a2, b2, z2],
-            [sx, sy, sz],
-            splat(t_max)
-        );
-        (hit, redo)
-    }
+    let [kx, ky, kz] = rays.axes;
+    let o = &rays.origin;
+    let (ox, oy, oz) = (F8::load(&o[0]), F8::load(&o[1]), F8::load(&o[2]));
+    // Each vertex relative to each lane's origin, in the axis order.
+    let rel = [
+        [
+            F8::splat(v[0][kx]).sub(ox),
+            F8::splat(v[0][ky]).sub(oy),
+            F8::splat(v[0][kz]).sub(oz),
+        ],
+        [
+            F8::splat(v[1][kx]).sub(ox),
+            F8::splat(v[1][ky]).sub(oy),
+            F8::splat(v[1][kz]).sub(oz),
+        ],
+        [
+            F8::splat(v[2][kx]).sub(ox),
+            F8::splat(v[2][ky]).sub(oy),
+            F8::splat(v[2][kz]).sub(oz),
+        ],
+    ];
+    let s = &rays.shear;
+    let shear = [F8::load(&s[0]), F8::load(&s[1]), F8::load(&s[2])];
+    let f = watertight_lanes(rel, shear, F8::splat(t_max), false);
+    (f.mask, f.redo)
 }
