@@ -115,6 +115,7 @@ pub struct Scene {
     default_lights: bool,
     step: f32,
     tone_map: ToneMap,
+    centre: Vec3,
 }
 
 /// Why a scene could not be built.
@@ -349,6 +350,11 @@ impl SceneBuilder {
                 .filter(|s| s.is_finite() && *s > 0.0)
                 .unwrap_or(1.0),
             tone_map: self.tone_map,
+            centre: if bounds.min.is_finite() && bounds.max.is_finite() {
+                (bounds.min + bounds.max) * 0.5
+            } else {
+                Vec3::ZERO
+            },
         })
     }
 }
@@ -418,6 +424,11 @@ impl Scene {
     pub fn with_effects(mut self, effects: Effects) -> Scene {
         self.effects = effects;
         self
+    }
+
+    /// The centre of the scene's bounding box (the origin for a scene without triangles).
+    pub fn centre(&self) -> Vec3 {
+        self.centre
     }
 
     /// Length of the bounding box's diagonal: the scene's scale.

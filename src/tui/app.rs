@@ -18,6 +18,9 @@ pub enum Message {
     Zoom(f32),
     /// Put the camera back where the scene starts it (the model framed again), lights kept.
     Frame,
+    /// Orbit the camera by these yaw and pitch angles in radians about the point ahead of it
+    /// as far as the scene's centre is (a mouse drag).
+    Orbit(f32, f32),
     /// Move the light by this offset in camera axes (right, down, forward), scene units.
     MoveLight(Vec3),
     /// Switch to a stage.
@@ -149,6 +152,17 @@ pub fn update(app: &mut App, msg: Message) {
             app.camera = app.scene.camera();
             true
         }
+        Message::Orbit(yaw, pitch) => {
+            let c = &mut app.camera;
+            let r = (app.scene.centre() - c.position).length();
+            let pivot = c.position + c.forward() * r;
+            let max = MAX_PITCH_DEGREES.to_radians();
+            c.yaw = (c.yaw + yaw + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU)
+                - std::f32::consts::PI;
+            c.pitch = (c.pitch + pitch).clamp(-max, max);
+            c.position = pivot - c.forward() * r;
+            yaw != 0.0 || pitch != 0.0
+        }
         Message::Turn(a) => {
             // Keep yaw in (−π, π] so the status line stays readable after many turns.
             let yaw = (app.camera.yaw + a + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU)
@@ -244,6 +258,17 @@ mod tests {
         update(&mut a, Message::Walk(0.1));
         assert!((a.camera.position - start - Vec3::new(0.1, 0.0, 0.1)).length() < TOLERANCE);
         assert_eq!(a.generation, 3);
+    }
+
+    /// Orbiting keeps the distance to the pivot and keeps looking at it.
+    #[test]
+    fn orbit_circles_the_point_looked_at() {
+        let mut a = app();
+        let r = (a.scene.centre() - a.camera.position).length();
+        let pivot = a.camera.position + a.camera.forward() * r;
+        update(&mut a, Message::Orbit(0.7, -0.3));
+        assert!((a.camera.position + a.camera.forward() * r - pivot).length() < TOLERANCE);
+        assert!(((a.camera.position - pivot).length() - r).abs() < TOLERANCE);
     }
 
     #[test]

@@ -14,6 +14,20 @@ pub struct KeyParser {
     pending: Vec<u8>,
     /// Replies to [`ACK_QUERY`] parsed and not yet taken.
     acks: usize,
+    /// Mouse events parsed and not yet taken.
+    mouse: Vec<Mouse>,
+    /// Where the left button was last reported while held (cell column, row).
+    held: Option<(i32, i32)>,
+}
+
+/// What the mouse did, from SGR mouse reports (`CSI < b ; x ; y M`, release `m`), which the app
+/// asks for with button-event tracking: motion is reported only while a button is held.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mouse {
+    /// Dragged with the left button by this many cells (right, down).
+    Drag(i32, i32),
+    /// The wheel turned one notch: -1 up, 1 down.
+    Wheel(i32),
 }
 
 /// The query appended after a frame to learn when the terminal has processed it: primary
@@ -44,6 +58,10 @@ impl KeyParser {
                     keys.extend(key);
                     i += used;
                 }
+                Parsed::Mouse(used, button, x, y, pressed) => {
+                    self.mouse_report(button, x, y, pressed);
+                    i += used;
+                }
                 Parsed::Incomplete => {
                     if buf.len() - i <= MAX_PENDING {
                         self.pending = buf[i..].to_vec();
@@ -53,6 +71,33 @@ impl KeyParser {
             }
         }
         keys
+    }
+
+    /// The mouse events in the bytes fed so far (since the last call).
+    pub fn take_mouse(&mut self) -> Vec<Mouse> {
+        std::mem::take(&mut self.mouse)
+    }
+
+    /// One SGR report: the wheel's notches, and left-button drags as moves from the last cell.
+    fn mouse_report(&mut self, button: u16, x: i32, y: i32, pressed: bool) {
+        if button & 64 != 0 {
+            if pressed {
+                self.mouse
+                    .push(Mouse::Wheel(if button & 1 == 0 { -1 } else { 1 }));
+            }
+            return;
+        }
+        if !pressed || button & 3 != 0 {
+            self.held = None;
+            return;
+        }
+        if button & 32 != 0
+            && let Some((lx, ly)) = self.held
+            && (x, y) != (lx, ly)
+        {
+            self.mouse.push(Mouse::Drag(x - lx, y - ly));
+        }
+        self.held = Some((x, y));
     }
 
     /// How many replies to [`ACK_QUERY`] the bytes fed so far held (since the last call):
@@ -91,6 +136,8 @@ enum Parsed {
     Key(usize, Option<KeyEvent>),
     /// Bytes used by the terminal's reply to [`ACK_QUERY`].
     Reply(usize),
+    /// Bytes used by an SGR mouse report: its button code, column, row, and press (not release).
+    Mouse(usize, u16, i32, i32, bool),
     /// The buffer ends inside a sequence.
     Incomplete,
 }
@@ -112,7 +159,7 @@ fn parse_one(b: &[u8]) -> Parsed {
             },
             // ESC then a key: Alt+key.
             Some(_) => match parse_one(&b[1..]) {
-                Parsed::Reply(n) => Parsed::Key(n + 1, None),
+                Parsed::Reply(n) | Parsed::Mouse(n, ..) => Parsed::Key(n + 1, None),
                 Parsed::Key(n, k) => Parsed::Key(
                     n + 1,
                     k.map(|mut k| {
@@ -173,6 +220,16 @@ fn parse_csi(b: &[u8]) -> Parsed {
         return Parsed::Reply(j + 1);
     }
     let params = std::str::from_utf8(&b[2..j]).unwrap_or("");
+    // An SGR mouse report: `CSI < button ; column ; row` then M (press, motion) or m (release).
+    if let Some(report) = params.strip_prefix('<') {
+        let n: Vec<Option<i32>> = report.split(';').map(|v| v.parse().ok()).collect();
+        return match (n.as_slice(), f) {
+            ([Some(b), Some(x), Some(y)], b'M' | b'm') if *b >= 0 => {
+                Parsed::Mouse(j + 1, *b as u16, *x, *y, f == b'M')
+            }
+            _ => Parsed::Key(j + 1, None),
+        };
+    }
     // xterm's modifier parameter "1;m": m − 1 is a bit set of Shift 1, Alt 2, Ctrl 4.
     let m: u8 = params
         .split(';')
@@ -220,6 +277,28 @@ mod tests {
             .into_iter()
             .map(|k| (k.code, k.modifiers))
             .collect()
+    }
+
+    /// Left-button drags become moves from the last reported cell, the wheel notches; a
+    /// release ends a drag, and a report split across reads waits for its end.
+    #[test]
+    fn mouse_drags_and_wheel() {
+        let mut p = KeyParser::default();
+        assert!(
+            p.feed(b"\x1b[<0;10;5M\x1b[<32;12;5M\x1b[<32;12;7M")
+                .is_empty()
+        );
+        assert_eq!(p.take_mouse(), vec![Mouse::Drag(2, 0), Mouse::Drag(0, 2)]);
+        assert!(
+            p.feed(b"\x1b[<0;12;7m\x1b[<32;20;7M\x1b[<64;1;1M\x1b[<6")
+                .is_empty()
+        );
+        assert_eq!(p.take_mouse(), vec![Mouse::Wheel(-1)]);
+        assert_eq!(
+            codes(&mut p, b"5;1;1Mx"),
+            vec![(KeyCode::Char('x'), KeyModifiers::NONE)]
+        );
+        assert_eq!(p.take_mouse(), vec![Mouse::Wheel(1)]);
     }
 
     #[test]

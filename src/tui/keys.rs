@@ -25,6 +25,10 @@ pub const KEYS: &[(&str, &str)] = &[
     ("PgUp / PgDn", "look up / down (Shift: finer)"),
     ("+ / -", "zoom in / out"),
     ("F", "frame the model again (the starting view)"),
+    (
+        "Mouse",
+        "drag: orbit; wheel: zoom (Shift+drag selects text)",
+    ),
     ("W / S", "light forward / back (Shift: finer)"),
     ("A / D", "light left / right (Shift: finer)"),
     ("Q / E", "light up / down (Shift: finer)"),
@@ -45,6 +49,20 @@ pub fn help_text() -> String {
         s.push_str(&format!("  {k:<13} {what}\n"));
     }
     s
+}
+
+/// One cell of mouse drag orbits the camera this many degrees.
+pub const ORBIT_DEGREES_PER_CELL: f32 = 2.0;
+
+/// The message for a mouse event: a drag orbits, the wheel zooms (up: in).
+pub fn message_for_mouse(m: super::input::Mouse) -> Option<Message> {
+    use super::input::Mouse;
+    let step = ORBIT_DEGREES_PER_CELL.to_radians();
+    match m {
+        Mouse::Drag(0, 0) | Mouse::Wheel(0) => None,
+        Mouse::Drag(dx, dy) => Some(Message::Orbit(dx as f32 * step, dy as f32 * step)),
+        Mouse::Wheel(n) => Some(Message::Zoom(ZOOM_STEP.powi(n))),
+    }
 }
 
 /// The message for a key, if it has one. Acts on presses and repeats, never on releases (the

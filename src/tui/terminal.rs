@@ -71,6 +71,8 @@ pub enum Outcome {
 /// What the loop waits for.
 enum Input {
     Key(KeyEvent),
+    /// A mouse drag or wheel notch.
+    Mouse(super::input::Mouse),
     /// The terminal was resized (SIGWINCH).
     Resize,
     /// The tty gave end-of-file or an error: the connection is gone.
@@ -196,6 +198,11 @@ fn spawn_reader_thread(fd: RawFd, tx: Sender<Input>, acks: Sender<Instant>) {
             }
             for k in keys {
                 if tx.send(Input::Key(k)).is_err() {
+                    return;
+                }
+            }
+            for m in parser.take_mouse() {
+                if tx.send(Input::Mouse(m)).is_err() {
                     return;
                 }
             }
@@ -350,6 +357,12 @@ fn handle(
                 update(app, m);
             }
             return Ok(app.quit.then_some(Outcome::Quit));
+        }
+        Input::Mouse(m) => {
+            if let Some(msg) = super::keys::message_for_mouse(m) {
+                update(app, msg);
+            }
+            return Ok(None);
         }
         Input::Resize => {
             if let Ok((cols, rows)) = tty::size() {

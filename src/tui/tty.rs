@@ -14,9 +14,9 @@ use std::time::{Duration, Instant};
 
 /// The bytes that put the screen back: cancel any half-written escape sequence (CAN), end a
 /// half-written synchronized frame, reset the pen, show the cursor, leave the alternate screen.
-const RESTORE_BYTES: &[u8] = b"\x18\x1b[?2026l\x1b[0m\x1b[?25h\x1b[?1049l";
+const RESTORE_BYTES: &[u8] = b"\x18\x1b[?2026l\x1b[0m\x1b[?1006l\x1b[?1002l\x1b[?25h\x1b[?1049l";
 /// Enter the alternate screen, hide the cursor, clear.
-const TAKE_BYTES: &[u8] = b"\x1b[?1049h\x1b[?25l\x1b[2J";
+const TAKE_BYTES: &[u8] = b"\x1b[?1049h\x1b[?25l\x1b[?1002h\x1b[?1006h\x1b[2J";
 /// How long [`restore`] waits for the terminal to take its bytes behind what is already
 /// queued, before it discards the queue (a stalled link: a frame nobody will see) and tries
 /// once more. With the exit that follows a signal this stays well inside its 2 s.
