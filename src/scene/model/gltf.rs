@@ -37,10 +37,11 @@ const MAX_NODE_VISITS: usize = 1_000_000;
 /// Reads `bytes` (a `.gltf` or `.glb`) as a model named `file`, its buffers through `read`.
 pub fn parse(bytes: &[u8], file: &str, read: FileReader) -> Result<Model, SceneFileError> {
     let whole = |m: String| SceneFileError::whole_file(file, m);
-    let gltf = match Gltf::from_slice(bytes) {
+    let gltf = match Gltf::from_slice_without_validation(bytes) {
         Ok(g) => g,
         Err(e) => return Err(parse_error(bytes, file, e)),
     };
+    validate(gltf.document.as_json()).map_err(|e| parse_error(bytes, file, e))?;
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for b in gltf.buffers() {
         let at = format!("/buffers/{}", b.index());
@@ -66,8 +67,9 @@ pub fn parse(bytes: &[u8], file: &str, read: FileReader) -> Result<Model, SceneF
     let mut model = Model::default();
     // Material 0 is the default; glTF material i is i + 1.
     model.materials.push(ModelMaterial::default());
+    let root = gltf.document.as_json();
     for m in gltf.materials() {
-        model.materials.push(material(&m, &mut model.notes));
+        model.materials.push(material(&m, root, &mut model.notes));
     }
     let roots: Vec<Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
         Some(s) => s.nodes().collect(),
@@ -109,15 +111,21 @@ pub fn parse(bytes: &[u8], file: &str, read: FileReader) -> Result<Model, SceneF
             }
         }
         if let Some(camera) = node.camera() {
-            match camera.projection() {
-                ::gltf::camera::Projection::Perspective(p) => model.cameras.push(ModelCamera {
+            // Read from the JSON: the crate's `projection()` unwraps the object the type names,
+            // which its validator does not require (a perspective camera with only an
+            // orthographic object would panic).
+            use ::gltf::json::camera::Type;
+            use ::gltf::json::validation::Checked;
+            let json = &root.cameras[camera.index()];
+            match (&json.type_, &json.perspective) {
+                (Checked::Valid(Type::Perspective), Some(p)) => model.cameras.push(ModelCamera {
                     position: world.transform_point3(Vec3::ZERO),
                     forward: world.transform_vector3(-Vec3::Z).normalize_or_zero(),
                     up: world.transform_vector3(Vec3::Y).normalize_or_zero(),
-                    fov: Some(p.yfov()),
+                    fov: Some(p.yfov),
                 }),
-                ::gltf::camera::Projection::Orthographic(_) => model.note(format!(
-                    "camera {}: orthographic cameras are not used",
+                _ => model.note(format!(
+                    "camera {}: only perspective cameras are used",
                     camera.index()
                 )),
             }
@@ -168,6 +176,42 @@ pub fn parse(bytes: &[u8], file: &str, read: FileReader) -> Result<Model, SceneF
         ));
     }
     Ok(model)
+}
+
+/// The `gltf` crate's validation, which `Gltf::from_slice` runs; first, what its validator
+/// takes for granted and would panic on (found by fuzzing: gltf-json 1.4.1 indexes the
+/// accessors with a primitive's POSITION index unchecked).
+fn validate(root: &::gltf::json::Root) -> Result<(), ::gltf::Error> {
+    use ::gltf::json::validation::{Error, Validate};
+    use ::gltf::json::{Path, mesh::Semantic, validation::Checked};
+    let mut errors: Vec<(Path, Error)> = Vec::new();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = primitive
+                .attributes
+                .get(&Checked::Valid(Semantic::Positions));
+            if position.is_some_and(|i| i.value() >= root.accessors.len()) {
+                let path = Path::new()
+                    .field("meshes")
+                    .index(m)
+                    .field("primitives")
+                    .index(p)
+                    .field("attributes")
+                    .key("POSITION");
+                errors.push((path, Error::IndexOutOfBounds));
+            }
+        }
+    }
+    if errors.is_empty() {
+        root.validate(root, Path::new, &mut |path, error| {
+            errors.push((path(), error))
+        });
+    }
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(::gltf::Error::Validation(errors))
+    }
 }
 
 /// A `gltf` crate error as a positioned message.
@@ -282,17 +326,22 @@ fn percent_decode(uri: &str) -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
-fn material(m: &::gltf::Material, notes: &mut Vec<String>) -> ModelMaterial {
+fn material(
+    m: &::gltf::Material,
+    root: &::gltf::json::Root,
+    notes: &mut Vec<String>,
+) -> ModelMaterial {
     let pbr = m.pbr_metallic_roughness();
     let base = Vec4::from(pbr.base_color_factor());
-    let texture = pbr
-        .base_color_texture()
-        .map(|t| match t.texture().source().source() {
-            ::gltf::image::Source::Uri { uri, .. } => uri.to_string(),
-            ::gltf::image::Source::View { .. } => {
-                format!("image {} (embedded)", t.texture().source().index())
-            }
-        });
+    // The image's URI from the JSON: the crate's `Image::source()` unwraps fields its validator
+    // does not require.
+    let texture = pbr.base_color_texture().map(|t| {
+        let image = t.texture().source().index();
+        match root.images.get(image).and_then(|i| i.uri.clone()) {
+            Some(uri) if !uri.starts_with("data:") => uri,
+            _ => format!("image {image} (embedded)"),
+        }
+    });
     if let Some(t) = &texture {
         let note = format!("texture {t}: not drawn yet (the base colour factor is)");
         if !notes.contains(&note) {

@@ -44,3 +44,20 @@ g("huge_count_no_view.gltf", lambda d: (d["accessors"][0].pop("bufferView"), d["
 g("exponential_instances.gltf", exponential)
 w("not_json.gltf", "{\"asset\": {\"version\": \"2.0\"},\n  \"nodes\": [ oops ]\n}")
 w("bad_glb_length.glb", b"glTF" + struct.pack("<II", 2, 0xffffff) + struct.pack("<II", 0xfffff0, 0x4E4F534A) + b"{}  ")
+# Found by fuzzing: no accessors at all, while a primitive names POSITION 0 (gltf-json 1.4.1's
+# validator indexed the accessors unchecked and panicked).
+g("position_accessor_missing.gltf", lambda d: d.update({"accessors": []}))
+# The gltf crate's accessors unwrap what its validator does not require: raytty reads these
+# from the JSON instead. A perspective camera with only an orthographic object is not used,
+# and an embedded image without a MIME type is only named.
+def camera_mismatch(d):
+    d["cameras"] = [{"type": "perspective", "orthographic": {"xmag": 1, "ymag": 1, "zfar": 10, "znear": 0.1}}]
+    d["nodes"].append({"camera": 0, "translation": [0, 0, 3]})
+    d["scenes"][0]["nodes"].append(1)
+g("ok_camera_type_mismatch.gltf", camera_mismatch)
+def image_without_mime(d):
+    d["images"] = [{"bufferView": 0}]
+    d["textures"] = [{"source": 0}]
+    d["materials"] = [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]
+    d["meshes"][0]["primitives"][0]["material"] = 0
+g("ok_image_without_mime.gltf", image_without_mime)
