@@ -59,12 +59,25 @@ impl Session {
         args: &[&str],
         term: &str,
     ) -> Session {
+        Session::start_pixels(cols, rows, (0, 0), first_frame_only, args, term)
+    }
+
+    /// [`Session::start_term`] in a pty whose size says `pixels` (width, height; zero: not
+    /// told, as many terminals leave it).
+    fn start_pixels(
+        cols: u16,
+        rows: u16,
+        pixels: (u16, u16),
+        first_frame_only: bool,
+        args: &[&str],
+        term: &str,
+    ) -> Session {
         let pair = native_pty_system()
             .openpty(PtySize {
                 rows,
                 cols,
-                pixel_width: 0,
-                pixel_height: 0,
+                pixel_width: pixels.0,
+                pixel_height: pixels.1,
             })
             .expect("open a pty");
         let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_raytty"));
@@ -72,6 +85,8 @@ impl Session {
         cmd.args(args);
         cmd.env("TERM", term);
         cmd.env_remove("NO_COLOR");
+        // Not inside the test runner's tmux, if any: the queries go to this pty as they are.
+        cmd.env_remove("TMUX");
         let child = pair.slave.spawn_command(cmd).expect("spawn raytty");
         drop(pair.slave);
         let mut reader = pair.master.try_clone_reader().expect("pty reader");
@@ -141,6 +156,27 @@ impl Session {
         });
     }
 
+    /// Reads output until the bytes written so far satisfy `cond`.
+    fn wait_raw(&mut self, what: &str, cond: impl Fn(&[u8]) -> bool) {
+        let deadline = Instant::now() + TIMEOUT;
+        while !cond(&self.raw) {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.output.recv_timeout(left) {
+                Ok(bytes) => self.process(&bytes),
+                Err(_) => panic!("timed out waiting for {what}"),
+            }
+        }
+    }
+
+    /// Waits for the start's graphics queries (the kitty query, then DA1 last), then answers
+    /// them with `answer` as a terminal would.
+    fn answer_queries(&mut self, answer: &[u8]) {
+        self.wait_raw("the graphics queries", |raw| {
+            find(raw, b"a=q").is_some_and(|at| find(&raw[at..], b"\x1b[c").is_some())
+        });
+        self.send(answer);
+    }
+
     fn send(&mut self, bytes: &[u8]) {
         let w = self.writer.as_mut().expect("the pty is open");
         w.write_all(bytes).expect("write to the pty");
@@ -195,6 +231,11 @@ fn expected(cols: u16, rows: u16, camera_z: f32, light_y: f32) -> CellGrid {
     let mut lights = scene.lights().to_vec();
     lights[0].position += camera.to_world(Vec3::new(0.0, light_y, 0.0));
     slow_link::app_image(&camera, &lights, cols, rows)
+}
+
+/// Where `part` first occurs in `bytes`.
+fn find(bytes: &[u8], part: &[u8]) -> Option<usize> {
+    bytes.windows(part.len()).position(|w| w == part)
 }
 
 fn nonzero(n: u16) -> NonZeroU16 {
@@ -740,4 +781,96 @@ fn behind_a_deep_buffer_a_terminal_that_answers_paces_the_frames() {
     // The answers were consumed as answers: nothing typed reached the app as keys (a reply
     // read as keys would be Esc, `[`, `?`... and Esc quits).
     assert!(link.child.try_wait().expect("the child's status").is_none());
+}
+
+/// The status line (the last row) of the screen.
+fn status_line(s: &vt100::Screen) -> String {
+    let (rows, cols) = (s.size().0.get(), s.size().1.get());
+    s.contents_between(rows - 1, 0, rows - 1, cols)
+}
+
+#[test]
+fn a_terminal_that_answers_kitty_gets_one_image_replaced_in_place_and_deleted_on_quit() {
+    let mut s = Session::start_with(60, 13, false, &["--graphics", "auto"]);
+    // kitty's answer, a cell of 8×16 pixels, and DA1 (which lists sixel too: kitty is first).
+    s.answer_queries(b"\x1b_Gi=31;OK\x1b\\\x1b[6;16;8t\x1b[?62;4;22c");
+    s.wait_for_status(&["kitty 480x192", "cornell"]);
+    let at = find(&s.raw, b"\x1b[c").unwrap();
+    let image = b"\x1b[H\x1b_Ga=T,f=24,o=z,q=2,s=480,v=192,i=1,p=1,c=60,r=12,C=1";
+    assert!(
+        find(&s.raw[at..], image).is_some(),
+        "the frame as one kitty image"
+    );
+    // A light move sends the image again under the same id (replaced in place).
+    s.send(b"q");
+    s.wait_raw("a second image", |raw| {
+        raw.windows(12).filter(|w| *w == b"i=1,p=1,c=60").count() >= 2
+    });
+    s.send(b"\x1b");
+    assert_eq!(s.finish().exit_code(), 0);
+    let delete = find(&s.raw, b"\x1b_Ga=d,d=A,q=2\x1b\\").expect("the images deleted");
+    let leave = find(&s.raw, b"\x1b[?1049l").expect("the alternate screen left");
+    assert!(delete < leave);
+}
+
+#[test]
+fn a_terminal_that_lists_sixel_and_tells_its_size_gets_sixel_frames() {
+    // The cell size from the pty's own pixel fields (TIOCGWINSZ): 6×12.
+    let mut s = Session::start_pixels(60, 13, (360, 156), false, &[], "xterm-256color");
+    s.answer_queries(b"\x1b[?63;1;2;4;6;9;15;22c");
+    s.wait_for_status(&["sixel 360x144"]);
+    assert!(find(&s.raw, b"\x1b[H\x1bP0;1;0q\"1;1;360;144").is_some());
+    // G turns the pixels off: text cells, exactly the text frame.
+    s.send(b"g");
+    s.wait_for("the text frame", |scr| {
+        shows(scr, &expected(60, 13, 0.0, 0.0))
+    });
+    s.send(b"\x1b");
+    assert_eq!(s.finish().exit_code(), 0);
+}
+
+#[test]
+fn a_terminal_that_does_not_answer_gets_text_and_nothing_of_the_queries_on_screen() {
+    let mut s = Session::start_with(60, 13, false, &[]);
+    s.wait_for("the text frame", |scr| {
+        shows(scr, &expected(60, 13, 0.0, 0.0))
+    });
+    let at = find(&s.raw, b"a=q").expect("the terminal was asked");
+    assert!(
+        find(&s.raw[at..], b"\x1b[2J").is_some(),
+        "cleared after asking"
+    );
+    let status = status_line(s.screen.screen());
+    assert!(
+        !status.contains("kitty") && !status.contains("sixel"),
+        "{status}"
+    );
+    // Nothing asked with --graphics none.
+    let mut none = Session::start_with(60, 13, false, &["--graphics", "none"]);
+    none.wait_for("the text frame", |scr| {
+        shows(scr, &expected(60, 13, 0.0, 0.0))
+    });
+    assert!(find(&none.raw, b"a=q").is_none());
+}
+
+#[test]
+fn wrong_answers_are_not_believed_and_a_late_answer_is_not_keys() {
+    let mut s = Session::start_with(60, 13, false, &[]);
+    // An error from kitty, a zero cell, DA1 listing sixel (but no size known): text.
+    s.answer_queries(b"\x1b_Gi=31;EINVAL:nope\x1b\\\x1b[6;0;0t\x1b[?62;4c");
+    s.wait_for("the text frame", |scr| {
+        shows(scr, &expected(60, 13, 0.0, 0.0))
+    });
+    let status = status_line(s.screen.screen());
+    assert!(
+        !status.contains("kitty") && !status.contains("sixel"),
+        "{status}"
+    );
+    // Answers arriving after the start are swallowed: `=` in them would zoom, `-` unzoom.
+    s.send(b"\x1b_Gi=31;OK\x1b\\\x1b[6;20;10t\x1b[4;240;600t\x1b[?62;4cq");
+    s.wait_for("the frame with the light moved up, unzoomed", |scr| {
+        shows(scr, &expected(60, 13, 0.0, -0.1))
+    });
+    s.send(b"\x1b");
+    assert_eq!(s.finish().exit_code(), 0);
 }

@@ -31,6 +31,12 @@ pub struct Cli {
     /// font without the glyphs shows boxes: press B to cycle back.
     #[arg(long, value_enum, default_value_t = CellsChoice::Auto)]
     pub(super) cells: CellsChoice,
+    /// Pixels in the app through a graphics protocol: auto (ask the terminal at start: kitty
+    /// if it answers kitty's query, sixel if its device attributes list sixel and it tells
+    /// its cell size; else text cells), kitty, sixel, or none (text cells, nothing asked).
+    /// Inside tmux, kitty goes through passthrough (set allow-passthrough on). G toggles.
+    #[arg(long, value_enum, default_value_t = GraphicsChoice::Auto)]
+    pub(super) graphics: GraphicsChoice,
     /// The scene: a scene file (a path that exists or ends in .toml) or a built-in scene's name
     /// (`raytty scenes` lists them). Default: the Cornell box.
     #[arg(long, global = true, value_name = "PATH|NAME")]
@@ -90,6 +96,19 @@ pub(super) enum ColorChoice {
     Ansi256,
     /// No colour escapes at all.
     Ascii,
+}
+
+/// The `--graphics` choices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(super) enum GraphicsChoice {
+    /// Ask the terminal.
+    Auto,
+    /// The kitty graphics protocol (kitty, WezTerm, Ghostty, Konsole).
+    Kitty,
+    /// Sixel (xterm -ti vt340, foot, WezTerm, mlterm, Windows Terminal).
+    Sixel,
+    /// Text cells only.
+    None,
 }
 
 /// The `--cells` choices.

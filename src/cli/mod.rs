@@ -68,7 +68,14 @@ pub fn main() -> u8 {
         Some(Command::Bench(a)) => stdout_is_open("the table")
             .and_then(|()| run_bench(a, scene, &view))
             .map(|()| 0),
-        None => run_default(color, resolve_cells(cli.cells, env), scene, &view, dumb),
+        None => run_default(
+            color,
+            resolve_cells(cli.cells, env),
+            cli.graphics,
+            scene,
+            &view,
+            dumb,
+        ),
     };
     match result {
         Ok(code) => code,
@@ -203,6 +210,7 @@ fn is_dumb(term: Option<&str>) -> bool {
 fn run_default(
     color: ColorMode,
     cells: raytty::frame::CellMode,
+    graphics: GraphicsChoice,
     scene: Option<&str>,
     view: &raytty::scene::model::View,
     dumb: bool,
@@ -223,12 +231,19 @@ fn run_default(
             if note {
                 eprint!("\r\x1b[2K");
             }
-            return Ok(crate::tui::run(loaded?, color, cells).map(app_status)?);
+            use crate::tui::detect::{Choice, Protocol};
+            let graphics = match graphics {
+                GraphicsChoice::Auto => Choice::Auto,
+                GraphicsChoice::Kitty => Choice::Force(Protocol::Kitty),
+                GraphicsChoice::Sixel => Choice::Force(Protocol::Sixel),
+                GraphicsChoice::None => Choice::None,
+            };
+            return Ok(crate::tui::run(loaded?, color, cells, graphics).map(app_status)?);
         }
         eprintln!("raytty: TERM=dumb cannot run the app (it moves the cursor): one frame follows");
     }
     #[cfg(not(feature = "tui"))]
-    let _ = (dumb, cells);
+    let _ = (dumb, cells, graphics);
     run_render(
         &RenderArgs {
             size: Some((80, 24)),

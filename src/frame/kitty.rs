@@ -9,11 +9,42 @@ pub const CHUNK: usize = 4096;
 /// `examples/cells_bench`).
 const LEVEL: u8 = 6;
 
+/// Where and how the app places its frame (see [`encode_kitty_placed`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Placement {
+    /// The image and placement id: sending an image with the id again replaces the old one
+    /// in place, without a blank frame between (the protocol's way to animate).
+    pub id: u32,
+    /// The cells the image is scaled to cover (columns, rows): a smaller image is scaled up
+    /// by the terminal.
+    pub cells: (u32, u32),
+}
+
 /// Appends to `out` the escapes that show `rgb` (`width × height` pixels, row-major) at the
 /// cursor, one pixel to one screen pixel, with the terminal's replies turned off (`q=2`): the
 /// image is sent whole (`a=T`, transmit and display), as 24-bit RGB (`f=24`) compressed with
 /// zlib (`o=z`), in chunks (`m=1` on all but the last).
 pub fn encode_kitty(rgb: &[[u8; 3]], width: u32, height: u32, out: &mut Vec<u8>) {
+    encode(rgb, width, height, None, out);
+}
+
+/// [`encode_kitty`], with the image given an id (`i`, and the placement `p`), scaled to cover
+/// `place.cells` (`c`, `r`), and the cursor left where it was (`C=1`, so an image that ends
+/// on the last row does not scroll the screen).
+pub fn encode_kitty_placed(
+    rgb: &[[u8; 3]],
+    width: u32,
+    height: u32,
+    place: Placement,
+    out: &mut Vec<u8>,
+) {
+    encode(rgb, width, height, Some(place), out);
+}
+
+/// The escape that deletes every image the terminal shows (`a=d,d=A`), replies off.
+pub const DELETE_ALL: &[u8] = b"\x1b_Ga=d,d=A,q=2\x1b\\";
+
+fn encode(rgb: &[[u8; 3]], width: u32, height: u32, place: Option<Placement>, out: &mut Vec<u8>) {
     debug_assert_eq!(rgb.len(), width as usize * height as usize);
     let raw: Vec<u8> = rgb.iter().flatten().copied().collect();
     let packed = miniz_oxide::deflate::compress_to_vec_zlib(&raw, LEVEL);
@@ -23,9 +54,12 @@ pub fn encode_kitty(rgb: &[[u8; 3]], width: u32, height: u32, out: &mut Vec<u8>)
         let more = u8::from(i + 1 < chunks.len());
         out.extend_from_slice(b"\x1b_G");
         if i == 0 {
-            out.extend_from_slice(
-                format!("a=T,f=24,o=z,q=2,s={width},v={height},m={more}").as_bytes(),
-            );
+            out.extend_from_slice(format!("a=T,f=24,o=z,q=2,s={width},v={height}").as_bytes());
+            if let Some(p) = place {
+                let (c, r) = p.cells;
+                out.extend_from_slice(format!(",i={0},p={0},c={c},r={r},C=1", p.id).as_bytes());
+            }
+            out.extend_from_slice(format!(",m={more}").as_bytes());
         } else {
             out.extend_from_slice(format!("m={more}").as_bytes());
         }

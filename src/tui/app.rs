@@ -5,6 +5,8 @@ use glam::Vec3;
 use raytty::frame::CellMode;
 use raytty::{Camera, ColorMode, PointLight, Scene, Stage};
 
+use super::detect::Protocol;
+
 /// Everything that can happen to the app.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Message {
@@ -31,6 +33,15 @@ pub enum Message {
     CycleColor,
     /// Next cell mode (half → quadrant → sextant → octant).
     CycleCells,
+    /// Pixels (the terminal's protocol, if it has one) on or off (text cells).
+    ToggleGraphics,
+    /// A terminal cell is now this many pixels wide and high (after a resize or a font change).
+    CellPixels {
+        /// Width in pixels.
+        width: u32,
+        /// Height in pixels.
+        height: u32,
+    },
     /// Show or hide the key help.
     ToggleHelp,
     /// Turn the GI denoiser on or off.
@@ -66,6 +77,14 @@ pub struct App {
     pub color: ColorMode,
     /// How many pixels a cell shows (half-blocks, quadrants, sextants, octants).
     pub cells: CellMode,
+    /// The pixel protocol the terminal speaks (asked at start, or forced), if any.
+    pub protocol: Option<Protocol>,
+    /// Whether frames are drawn with [`App::protocol`] rather than in text cells.
+    pub pixels: bool,
+    /// A cell's size in pixels (width, height): the pixel modes render at it.
+    pub cell_pixels: (u32, u32),
+    /// Pixel escapes go through tmux's passthrough.
+    pub tmux: bool,
     /// Whether the key help covers the frame.
     pub help: bool,
     /// Whether the GI stage's indirect light is denoised (the raw, unbiased estimate if not).
@@ -93,6 +112,10 @@ impl App {
             stage: Stage::Indirect,
             color,
             cells: CellMode::Half,
+            protocol: None,
+            pixels: false,
+            cell_pixels: super::detect::FALLBACK_CELL,
+            tmux: false,
             help: false,
             denoise: true,
             size,
@@ -111,6 +134,12 @@ impl App {
         } else {
             self.cells
         }
+    }
+
+    /// The pixel protocol frames are drawn with now, if any (none while the help is shown:
+    /// it is text).
+    pub fn graphics(&self) -> Option<Protocol> {
+        self.protocol.filter(|_| self.pixels && !self.help)
     }
 
     /// The position of the light the keys move, if the scene has one.
@@ -204,6 +233,19 @@ pub fn update(app: &mut App, msg: Message) {
             app.cells = app.cells.next();
             app.dirty = true;
             app.cell_mode() != before
+        }
+        // The image is rendered again at the new mode's size.
+        Message::ToggleGraphics => {
+            let on = app.protocol.is_some() && !app.pixels;
+            let changed = on != app.pixels;
+            app.pixels = on;
+            app.dirty = true;
+            changed
+        }
+        Message::CellPixels { width, height } => {
+            let changed = (width, height) != app.cell_pixels;
+            app.cell_pixels = (width, height);
+            changed && app.graphics().is_some()
         }
         Message::ToggleHelp => {
             app.help = !app.help;
@@ -332,6 +374,22 @@ mod tests {
         );
         assert_eq!((a.generation, a.size), (2, (100, 30)));
         assert!(!a.quit);
+        // Pixels toggle only where the terminal has a protocol.
+        update(&mut a, Message::ToggleGraphics);
+        assert!(!a.pixels);
+        a.protocol = Some(Protocol::Kitty);
+        update(&mut a, Message::ToggleGraphics);
+        assert!(a.pixels && a.graphics().is_none(), "the help is text");
+        update(&mut a, Message::ToggleHelp);
+        assert_eq!(a.graphics(), Some(Protocol::Kitty));
+        update(
+            &mut a,
+            Message::CellPixels {
+                width: 9,
+                height: 18,
+            },
+        );
+        assert_eq!((a.generation, a.cell_pixels), (4, (9, 18)));
         update(&mut a, Message::Quit);
         assert!(a.quit);
     }

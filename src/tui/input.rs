@@ -5,8 +5,9 @@
 
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
-/// Longest escape sequence kept across reads; anything longer is dropped as garbage.
-const MAX_PENDING: usize = 32;
+/// Longest escape sequence kept across reads; anything longer is dropped as garbage. Room for
+/// a kitty graphics answer with its error message.
+const MAX_PENDING: usize = 64;
 
 /// Parses a byte stream into key events, keeping an incomplete sequence for the next read.
 #[derive(Debug, Default)]
@@ -153,6 +154,12 @@ fn parse_one(b: &[u8]) -> Parsed {
             None => Parsed::Incomplete,
             Some(0x1b) => Parsed::Key(1, key(KeyCode::Esc, none)),
             Some(b'[') => parse_csi(b),
+            // An APC or DCS string (a late answer to the start's graphics queries: kitty's
+            // `ESC _ G i=31;OK ESC \`): swallowed whole, never keys.
+            Some(b'_' | b'P') => match b.windows(2).position(|w| w == b"\x1b\\") {
+                Some(end) => Parsed::Key(end + 2, None),
+                None => Parsed::Incomplete,
+            },
             Some(b'O') => match b.get(2) {
                 None => Parsed::Incomplete,
                 Some(&f) => Parsed::Key(3, arrow(f).map(|c| KeyEvent::new(c, none))),
@@ -407,6 +414,15 @@ mod tests {
         assert!(p.waiting_on_escape());
         assert_eq!(codes(&mut p, b"[?1;2cq"), vec![(KeyCode::Char('q'), n)]);
         assert_eq!(p.take_acks(), 1);
+        // A late answer to the graphics queries, split, between keys: no key from it.
+        assert_eq!(
+            codes(&mut p, b"w\x1b_Gi=31;O"),
+            vec![(KeyCode::Char('w'), n)]
+        );
+        assert_eq!(
+            codes(&mut p, b"K\x1b\\\x1b[6;20;10tq"),
+            vec![(KeyCode::Char('q'), n)]
+        );
         // Other CSI ... c sequences (no `?`) are not replies.
         assert_eq!(codes(&mut p, b"\x1b[0c"), vec![]);
         assert_eq!(p.take_acks(), 0);

@@ -37,6 +37,7 @@ pub const KEYS: &[(&str, &str)] = &[
     ("R", "reset camera and light"),
     ("C", "colour mode: truecolor 256 ascii"),
     ("B", "cells: half quadrant sextant octant"),
+    ("G", "pixels (kitty or sixel) on / off"),
     ("H or ?", "this help"),
     ("Ctrl-Z", "suspend (fg resumes)"),
     ("Esc, Ctrl-C", "quit"),
@@ -108,6 +109,7 @@ pub fn message_for(key: KeyEvent) -> Option<Message> {
                 'n' => Some(Message::ToggleDenoise),
                 'c' => Some(Message::CycleColor),
                 'b' => Some(Message::CycleCells),
+                'g' => Some(Message::ToggleGraphics),
                 'h' | '?' => Some(Message::ToggleHelp),
                 d @ '1'..='9' => Stage::ALL
                     .get(d as usize - '1' as usize)

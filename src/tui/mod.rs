@@ -4,10 +4,12 @@
 //! raw mode, restoring).
 
 pub mod app;
+pub mod detect;
 pub mod input;
 pub mod keys;
 pub mod link;
 pub mod overlay;
+pub mod pixels;
 pub mod terminal;
 pub mod tty;
 pub mod view;

@@ -26,6 +26,7 @@ use signal_hook::consts::{SIGHUP, SIGINT, SIGQUIT, SIGSTOP, SIGTERM, SIGWINCH};
 use signal_hook::iterator::Signals;
 
 use super::app::{App, Message, update};
+use super::detect::{self, Answers, Choice, Protocol};
 use super::input::{ACK_QUERY, ESC_DELAY, KeyParser};
 use super::keys::message_for;
 use super::link::{ACK_WAIT, Acks, Link};
@@ -52,6 +53,12 @@ const MAX_PACING_WAIT: Duration = Duration::from_millis(250);
 /// On quitting, how long the app waits for the terminal to answer the queries still
 /// outstanding (an answer arriving after the restore would be echoed on the shell's line).
 const QUIT_ACK_WAIT: Duration = Duration::from_millis(300);
+/// How long the start waits for the terminal's answers to the graphics queries. Every
+/// terminal answers the DA1 that ends them at once (over ssh, a round trip later), so this is
+/// waited out only by one that answers nothing, or inside tmux (whose passthrough may bring
+/// no answer at all).
+const DETECT_TIMEOUT: Duration = Duration::from_millis(400);
+
 /// Queries written and not answered yet (the writer adds, the reader takes away).
 static UNANSWERED: AtomicUsize = AtomicUsize::new(0);
 /// The terminal answers queries (set by the writer).
@@ -129,7 +136,7 @@ fn suspend() -> Result<()> {
 
 /// Runs the app on the terminal until the user quits, the terminal goes away or a signal
 /// arrives, and says which.
-pub fn run(scene: Scene, color: ColorMode, cells: CellMode) -> Result<Outcome> {
+pub fn run(scene: Scene, color: ColorMode, cells: CellMode, graphics: Choice) -> Result<Outcome> {
     let stdin = io::stdin();
     let dev_tty;
     let input: RawFd = if stdin.is_terminal() {
@@ -143,12 +150,21 @@ pub fn run(scene: Scene, color: ColorMode, cells: CellMode) -> Result<Outcome> {
         .context("cannot install signal handlers")?;
     let guard = Guard::enter(input)?;
     spawn_signal_thread(signals, tx.clone());
-    let (ack_tx, ack_rx) = mpsc::channel();
-    spawn_reader_thread(input, tx.clone(), ack_tx);
-    let writer = spawn_writer_thread(tx, ack_rx);
     let size = tty::size().context("cannot read the terminal size")?;
+    let tmux = std::env::var_os("TMUX").is_some();
+    let found = detect(input, graphics, size, tmux);
+    let (ack_tx, ack_rx) = mpsc::channel();
+    spawn_reader_thread(input, tx.clone(), ack_tx, found.keys);
+    let writer = spawn_writer_thread(tx, ack_rx);
     let mut app = App::new(scene, color, size);
     app.cells = cells;
+    app.protocol = found.protocol;
+    app.pixels = found.protocol.is_some();
+    app.cell_pixels = found.cell;
+    app.tmux = tmux;
+    if found.protocol == Some(Protocol::Kitty) {
+        tty::kitty_images(tmux);
+    }
     let outcome = event_loop(app, &rx, &writer);
     if matches!(outcome, Ok(Outcome::Quit)) {
         // Let the answers to the last queries come in while raw mode still hides them, so
@@ -165,13 +181,62 @@ pub fn run(scene: Scene, color: ColorMode, cells: CellMode) -> Result<Outcome> {
     outcome
 }
 
+/// What the start learnt of the terminal.
+struct Found {
+    /// The protocol to draw with.
+    protocol: Option<Protocol>,
+    /// A cell's size in pixels (or [`detect::FALLBACK_CELL`]).
+    cell: (u32, u32),
+    /// Bytes read meanwhile that were not answers: keys, for the reader.
+    keys: Vec<u8>,
+}
+
+/// Asks the terminal what it can show (see [`detect`]), unless `choice` is none, and reads
+/// its answers until DA1's (or [`DETECT_TIMEOUT`]). Then clears the screen: a terminal that
+/// printed a query it did not understand shows nothing of it.
+fn detect(input: RawFd, choice: Choice, size: (u16, u16), tmux: bool) -> Found {
+    let ws = tty::winsize().ok();
+    let from_winsize =
+        ws.and_then(|w| detect::cell_from_winsize(w.ws_col, w.ws_row, w.ws_xpixel, w.ws_ypixel));
+    let mut answers = Answers::default();
+    if choice != Choice::None && tty::write_now(&detect::queries(tmux), DETECT_TIMEOUT) {
+        let deadline = Instant::now() + DETECT_TIMEOUT;
+        let mut buf = [0u8; 1024];
+        while !answers.done(tmux) {
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() || !tty::wait_readable(input, Some(left)) {
+                break;
+            }
+            // SAFETY: reads into `buf`, within its length.
+            let n = unsafe { libc::read(input, buf.as_mut_ptr().cast(), buf.len()) };
+            if n <= 0 {
+                break;
+            }
+            answers.feed(&buf[..n as usize]);
+        }
+        tty::write_now(b"\x1b[2J", DETECT_TIMEOUT);
+    }
+    let cell = from_winsize.or_else(|| answers.cell_size(size.0, size.1.max(1)));
+    Found {
+        protocol: detect::choose(choice, &answers, cell.is_some()),
+        cell: cell.unwrap_or(detect::FALLBACK_CELL),
+        keys: answers.take_other(),
+    }
+}
+
 /// Reads keys until end-of-file or an error. A lone ESC waits up to [`ESC_DELAY`] for the rest
 /// of a sequence a slow link may have split. The terminal's replies to the writer's queries go
 /// to the writer (`acks`, with the time they arrived), never to the loop as keys.
-fn spawn_reader_thread(fd: RawFd, tx: Sender<Input>, acks: Sender<Instant>) {
+fn spawn_reader_thread(fd: RawFd, tx: Sender<Input>, acks: Sender<Instant>, early: Vec<u8>) {
     std::thread::spawn(move || {
         let mut parser = KeyParser::default();
         let mut buf = [0u8; 1024];
+        // Keys typed while the start waited for the terminal's answers.
+        for k in parser.feed(&early) {
+            if tx.send(Input::Key(k)).is_err() {
+                return;
+            }
+        }
         loop {
             let wait = parser.waiting_on_escape().then_some(ESC_DELAY);
             let keys = if tty::wait_readable(fd, wait) {
@@ -365,8 +430,15 @@ fn handle(
             return Ok(None);
         }
         Input::Resize => {
-            if let Ok((cols, rows)) = tty::size() {
+            if let Ok(ws) = tty::winsize() {
+                let (cols, rows) = (ws.ws_col, ws.ws_row);
                 update(app, Message::Resize { cols, rows });
+                // A new size may come with a new font size: the pixels follow the terminal.
+                if let Some((width, height)) =
+                    detect::cell_from_winsize(cols, rows, ws.ws_xpixel, ws.ws_ypixel)
+                {
+                    update(app, Message::CellPixels { width, height });
+                }
             }
         }
         Input::Hangup => return Ok(Some(Outcome::Hangup)),
@@ -390,11 +462,22 @@ fn event_loop(mut app: App, rx: &Receiver<Input>, writer: &Sender<Job>) -> Resul
     loop {
         let can_draw = stale && !busy;
         if !screen.needs_render(&app) && !can_draw {
-            // Idle: block until a key, a resize, a signal or the writer.
-            let Ok(input) = rx.recv() else {
-                return Ok(Outcome::Hangup);
+            // Idle: block until a key, a resize, a signal or the writer; in a pixel mode
+            // showing a reduced frame, at most until it is due at full resolution.
+            let input = match screen.upgrade_in(&app) {
+                Some(wait) => match rx.recv_timeout(wait) {
+                    Ok(input) => Some(input),
+                    Err(mpsc::RecvTimeoutError::Timeout) => None,
+                    Err(mpsc::RecvTimeoutError::Disconnected) => return Ok(Outcome::Hangup),
+                },
+                None => match rx.recv() {
+                    Ok(input) => Some(input),
+                    Err(_) => return Ok(Outcome::Hangup),
+                },
             };
-            if let Some(outcome) = handle(&mut app, &mut screen, input, &mut busy)? {
+            if let Some(input) = input
+                && let Some(outcome) = handle(&mut app, &mut screen, input, &mut busy)?
+            {
                 return Ok(outcome);
             }
         }

@@ -9,7 +9,7 @@
 use std::io;
 use std::os::fd::{AsRawFd, IntoRawFd, RawFd};
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicI32, AtomicU8, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 /// The bytes that put the screen back: cancel any half-written escape sequence (CAN), end a
@@ -43,6 +43,10 @@ static TERMIOS_FD: AtomicI32 = AtomicI32::new(-1);
 static WRITER_FD: AtomicI32 = AtomicI32::new(-1);
 /// [`restore`]'s non-blocking output descriptor.
 static RESTORE_FD: AtomicI32 = AtomicI32::new(-1);
+/// kitty graphics were sent: [`restore`] deletes the images first.
+static KITTY_IMAGES: AtomicBool = AtomicBool::new(false);
+/// ... through tmux's passthrough.
+static KITTY_VIA_TMUX: AtomicBool = AtomicBool::new(false);
 /// The terminal's settings before raw mode.
 static SAVED: OnceLock<libc::termios> = OnceLock::new();
 
@@ -118,6 +122,12 @@ pub fn restore() {
             }
             silence_writer();
             let fd = RESTORE_FD.load(Ordering::SeqCst);
+            if KITTY_IMAGES.load(Ordering::SeqCst) {
+                // The images go first (leaving the alternate screen would not remove them
+                // from every terminal), within the same bounded drain.
+                let delete = kitty_delete(KITTY_VIA_TMUX.load(Ordering::SeqCst));
+                write_until(fd, &delete, Instant::now() + RESTORE_DRAIN);
+            }
             if !write_until(fd, RESTORE_BYTES, Instant::now() + RESTORE_DRAIN) {
                 // SAFETY: tcflush on our own descriptor of the terminal.
                 unsafe { libc::tcflush(fd, libc::TCOFLUSH) };
@@ -133,6 +143,34 @@ pub fn restore() {
         }
         Err(_) => {}
     }
+}
+
+/// The app is about to send kitty graphics (through tmux's passthrough if `tmux`): from now
+/// on [`restore`] deletes every image first.
+pub fn kitty_images(tmux: bool) {
+    KITTY_VIA_TMUX.store(tmux, Ordering::SeqCst);
+    KITTY_IMAGES.store(true, Ordering::SeqCst);
+}
+
+/// The bytes that delete every kitty image, wrapped for tmux if `tmux`.
+pub fn kitty_delete(tmux: bool) -> Vec<u8> {
+    let mut out = Vec::new();
+    if tmux {
+        super::detect::tmux_passthrough(raytty::frame::KITTY_DELETE_ALL, &mut out);
+    } else {
+        out.extend_from_slice(raytty::frame::KITTY_DELETE_ALL);
+    }
+    out
+}
+
+/// Writes `bytes` to the terminal through the writer's descriptor, waiting at most `timeout`
+/// for room (the start's queries, before the writer thread runs). Whether all went.
+pub fn write_now(bytes: &[u8], timeout: Duration) -> bool {
+    write_until(
+        WRITER_FD.load(Ordering::SeqCst),
+        bytes,
+        Instant::now() + timeout,
+    )
 }
 
 /// Points the writer's descriptor at `/dev/null`: whatever it writes from now on goes nowhere.
@@ -216,6 +254,12 @@ pub fn writer_fd() -> RawFd {
 
 /// The terminal's size in (columns, rows).
 pub fn size() -> io::Result<(u16, u16)> {
+    winsize().map(|ws| (ws.ws_col, ws.ws_row))
+}
+
+/// The terminal's size as `TIOCGWINSZ` gives it: columns, rows, and the pixel fields (zero
+/// where the terminal does not fill them).
+pub fn winsize() -> io::Result<libc::winsize> {
     let mut ws = libc::winsize {
         ws_row: 0,
         ws_col: 0,
@@ -226,5 +270,5 @@ pub fn size() -> io::Result<(u16, u16)> {
     if unsafe { libc::ioctl(RESTORE_FD.load(Ordering::SeqCst), libc::TIOCGWINSZ, &mut ws) } != 0 {
         return Err(io::Error::last_os_error());
     }
-    Ok((ws.ws_col, ws.ws_row))
+    Ok(ws)
 }

@@ -13,8 +13,10 @@ use raytty::{
 };
 
 use super::app::App;
+use super::detect::Protocol;
 use super::link::describe;
 use super::overlay::{blank, draw_help, put_line, put_text, text_width};
+use super::pixels::{self, Costs, SETTLE};
 
 /// Smallest terminal drawn: below this a short message replaces the frame.
 pub const MIN_COLS: u16 = 10;
@@ -89,6 +91,17 @@ pub struct Screen {
     approximate: bool,
     /// The last frame's costs.
     pub stats: DrawStats,
+    /// Pixel modes: one rendered pixel for `scale × scale` screen pixels (1 in text modes).
+    scale: u32,
+    /// When the image's inputs last changed (pixel modes: a reduced frame is refined to full
+    /// resolution [`SETTLE`] after).
+    changed_at: Instant,
+    /// The pixel protocol the screen shows an image in, if it does.
+    showing: Option<Protocol>,
+    /// The image on screen is the current one (pixel modes).
+    image_sent: bool,
+    /// Pixel modes: what frames cost per rendered pixel.
+    costs: Costs,
     /// The link as the writer measures it: each frame is fitted to its budget.
     pub link: LinkView,
 }
@@ -146,6 +159,11 @@ impl Screen {
             approximate: false,
             stats: DrawStats::default(),
             link: LinkView::default(),
+            scale: 1,
+            changed_at: Instant::now(),
+            showing: None,
+            image_sent: false,
+            costs: Costs::default(),
         }
     }
 
@@ -153,6 +171,7 @@ impl Screen {
     /// terminal was handed to another program, e.g. while suspended).
     pub fn forget_shown(&mut self) {
         self.shown = None;
+        self.image_sent = false;
     }
 
     /// Passes accumulated for the current image.
@@ -163,20 +182,70 @@ impl Screen {
     /// Whether [`Screen::render`] has work to do: the app changed, GI is still refining, or
     /// the denoiser was switched.
     pub fn needs_render(&self, app: &App) -> bool {
-        image_size(app.size, app.cell_mode()).is_some()
+        self.render_size(app).is_some()
             && (self.generation != Some(app.generation)
+                || self.upgrade_in(app) == Some(Duration::ZERO)
+                || self.render_size(app) != Some((self.image.width, self.image.height))
                 || (app.stage == Stage::Gi
                     && (self.passes < GI_MAX_PASSES || self.shows_denoised != Some(app.denoise))))
+    }
+
+    /// Pixel modes: how long until the reduced image on screen is rendered again at full
+    /// resolution (zero: now), if it is reduced. The event loop waits at most this long.
+    pub fn upgrade_in(&self, app: &App) -> Option<Duration> {
+        (app.graphics().is_some() && self.scale > 1)
+            .then(|| SETTLE.saturating_sub(self.changed_at.elapsed()))
+    }
+
+    /// The size the image is rendered at: the cell mode's pixels a cell, or in a pixel mode
+    /// the terminal's pixels over the current scale; `None` if the terminal is too small.
+    fn render_size(&self, app: &App) -> Option<(u32, u32)> {
+        let size = image_size(app.size, app.cell_mode())?;
+        match app.graphics() {
+            None => Some(size),
+            Some(p) => Some(pixels::scaled(
+                pixels::full_size(p, app.size, app.cell_pixels),
+                self.scale,
+            )),
+        }
+    }
+
+    /// Picks the scale of the next render: a change of the image's inputs renders at the
+    /// moving scale (see [`pixels::moving_scale`]), and [`SETTLE`] after the last change at
+    /// full resolution.
+    fn pick_scale(&mut self, app: &App) {
+        let Some(p) = app.graphics() else {
+            self.scale = 1;
+            return;
+        };
+        if self.generation != Some(app.generation) {
+            self.changed_at = Instant::now();
+            let full = pixels::full_size(p, app.size, app.cell_pixels);
+            self.scale = pixels::moving_scale(full, self.costs, self.link.budget);
+        } else if self.upgrade_in(app) == Some(Duration::ZERO) {
+            self.scale = 1;
+        }
     }
 
     /// Renders one frame, or one more progressive pass in the GI stage (which restarts when
     /// the app's generation changes, but for a light move, which keeps a bounded history: see
     /// [`LIGHT_MOVE_HISTORY`]). Does nothing if the terminal is too small.
     pub fn render(&mut self, app: &App) {
-        let Some((w, h)) = image_size(app.size, app.cell_mode()) else {
+        self.pick_scale(app);
+        let Some((w, h)) = self.render_size(app) else {
             return;
         };
+        self.image_sent = false;
         let mut history = u32::MAX;
+        if (w, h) != (self.image.width, self.image.height)
+            && self.generation == Some(app.generation)
+        {
+            // The same view at another resolution (refined, or pixels toggled): GI starts
+            // again at the new size.
+            self.passes = 0;
+            self.spent = Duration::ZERO;
+            self.guides = None;
+        }
         if self.generation != Some(app.generation) {
             self.generation = Some(app.generation);
             self.passes = 0;
@@ -204,6 +273,7 @@ impl Screen {
         if app.stage != Stage::Gi {
             let frame = self.cache.render(&app.scene, &options);
             self.stats.render = frame.stats;
+            self.measure_render(frame.stats.elapsed, w, h);
             self.passes = GI_MAX_PASSES;
             self.guides = None;
             self.gi_view = None;
@@ -217,6 +287,7 @@ impl Screen {
                 .cache
                 .render(&app.scene, &Options { output, ..options });
             self.stats.render = frame.stats;
+            self.measure_render(frame.stats.elapsed, w, h);
             self.spent += frame.stats.elapsed;
             if let Some(new) = frame.guides {
                 match &mut self.guides {
@@ -247,6 +318,11 @@ impl Screen {
         self.shows_denoised = Some(app.denoise);
     }
 
+    /// Pixel modes learn a render's time per pixel.
+    fn measure_render(&mut self, elapsed: Duration, w: u32, h: u32) {
+        self.costs.seconds = Some(elapsed.as_secs_f64() / (f64::from(w) * f64::from(h)).max(1.0));
+    }
+
     /// Whether the terminal shows only an approximation of the latest frame (the link's budget
     /// left some cells within a tolerance, or unsent): drawing again refines it.
     pub fn approximate(&self) -> bool {
@@ -258,7 +334,17 @@ impl Screen {
     /// the smallest tolerance that fits are left for a later draw (see [`Screen::approximate`]).
     /// Remembers what the terminal now shows.
     pub fn draw(&mut self, app: &App) -> Vec<u8> {
+        if let Some(p) = app.graphics()
+            && self.render_size(app) == Some((self.image.width, self.image.height))
+        {
+            return self.draw_pixels(app, p);
+        }
         let start = Instant::now();
+        let mut out = SYNC_BEGIN.to_vec();
+        if self.showing.take().is_some() {
+            // Text over an image: the image goes, and every cell is drawn again.
+            self.hide_image(app, &mut out);
+        }
         let (cols, rows) = (app.size.0 as usize, app.size.1 as usize);
         let grid = if image_size(app.size, app.cell_mode())
             != Some((self.image.width, self.image.height))
@@ -296,10 +382,66 @@ impl Screen {
             put_line(&mut grid, rows - 1, &self.status(app), app.color);
         }
         // Encoded straight after the begin marker: the frame is written into place, not copied.
-        let mut out = SYNC_BEGIN.to_vec();
         let outcome = encode_diff_within(&mut self.shown, &grid, 0, limits, &mut out);
         self.next_row = outcome.next_row;
         self.approximate = !outcome.complete || outcome.max_error > 0;
+        if out.len() == SYNC_BEGIN.len() {
+            return Vec::new();
+        }
+        out.extend_from_slice(SYNC_END);
+        self.stats.encode = start.elapsed();
+        self.stats.bytes = out.len();
+        out
+    }
+
+    /// Removes the image from the screen (kitty: deleted; sixel: the screen cleared) and
+    /// forgets the text cells, so the next text frame draws every cell.
+    fn hide_image(&mut self, app: &App, out: &mut Vec<u8>) {
+        if app.protocol == Some(Protocol::Kitty) {
+            out.extend_from_slice(&super::tty::kitty_delete(app.tmux));
+        }
+        out.extend_from_slice(b"\x1b[2J");
+        self.shown = None;
+        self.image_sent = false;
+    }
+
+    /// A pixel-mode frame: the image if it is not on screen yet (whole: kitty replaces the
+    /// last one in place, sixel paints over it), then the status line as text.
+    fn draw_pixels(&mut self, app: &App, p: Protocol) -> Vec<u8> {
+        let start = Instant::now();
+        let mut out = SYNC_BEGIN.to_vec();
+        if self.showing != Some(p) {
+            // From text (or the other protocol): the screen starts blank.
+            if self.showing.is_some() {
+                self.hide_image(app, &mut out);
+            }
+            out.extend_from_slice(b"\x1b[0m\x1b[2J");
+            self.shown = None;
+            self.image_sent = false;
+        }
+        self.showing = Some(p);
+        self.drawn = self.generation;
+        self.approximate = false;
+        if !self.image_sent {
+            let shown = app.scene.tone_map().image(&self.image);
+            let (w, h) = (self.image.width, self.image.height);
+            let full = pixels::full_size(p, app.size, app.cell_pixels);
+            let cells = (u32::from(app.size.0), u32::from(app.size.1) - 1);
+            let before = out.len();
+            pixels::frame_bytes(p, &shown.to_rgb8(), (w, h), full, cells, app.tmux, &mut out);
+            self.costs.bytes = Some((out.len() - before) as f64 / (f64::from(w) * f64::from(h)));
+            self.image_sent = true;
+        }
+        let (cols, rows) = (app.size.0 as usize, app.size.1 as usize);
+        let mut status = blank(cols, 1, app.color);
+        put_line(&mut status, 0, &self.status(app), app.color);
+        encode_diff_within(
+            &mut self.shown,
+            &status,
+            rows - 1,
+            DiffLimits::EXACT,
+            &mut out,
+        );
         if out.len() == SYNC_BEGIN.len() {
             return Vec::new();
         }
@@ -368,14 +510,21 @@ impl Screen {
                 },
                 1,
             ),
-            (
+            match app.graphics() {
+                // The protocol and the resolution rendered (reduced while moving).
+                Some(p) => (
+                    format!("{} {}x{}", p.name(), self.image.width, self.image.height),
+                    1,
+                ),
                 // The cell mode when it is not the default half-blocks (ASCII has none).
-                match (app.color, app.cells) {
-                    (ColorMode::Ascii, _) | (_, CellMode::Half) => app.color.name().to_string(),
-                    _ => format!("{} {}", app.color.name(), app.cells.name()),
-                },
-                6,
-            ),
+                None => (
+                    match (app.color, app.cells) {
+                        (ColorMode::Ascii, _) | (_, CellMode::Half) => app.color.name().to_string(),
+                        _ => format!("{} {}", app.color.name(), app.cells.name()),
+                    },
+                    6,
+                ),
+            },
             ("H:help".to_string(), 2),
         ];
         fields.retain(|(t, _)| !t.is_empty());

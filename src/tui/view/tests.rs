@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::tui::app::{Message, update};
+use crate::tui::detect::Protocol;
 use glam::Vec3;
 use raytty::{ColorMode, cornell_box};
 
@@ -301,4 +302,87 @@ fn the_status_line_starts_with_the_scene_name_without_control_characters() {
         shown.contains("evil[2Jbox"),
         "the scene's name is not shown"
     );
+}
+
+fn pixel_app(protocol: Protocol) -> App {
+    let mut a = app(40, 13);
+    a.protocol = Some(protocol);
+    a.pixels = true;
+    a.cell_pixels = (4, 8);
+    a
+}
+
+fn contains(bytes: &[u8], part: &[u8]) -> bool {
+    bytes.windows(part.len()).any(|w| w == part)
+}
+
+/// kitty: the frame is one image at the terminal's pixels, placed over the cells above the
+/// status line under one id (so the next replaces it), the status line as text; a move
+/// renders lower while moving and full again once settled; the help is text and deletes it.
+#[test]
+fn kitty_frames_replace_one_image_and_refine_to_full_resolution() {
+    let mut a = pixel_app(Protocol::Kitty);
+    let mut s = Screen::new();
+    assert!(s.needs_render(&a));
+    s.render(&a);
+    assert_eq!((s.image.width, s.image.height), (160, 96));
+    let first = s.draw(&a);
+    assert!(contains(
+        &first,
+        b"\x1b[H\x1b_Ga=T,f=24,o=z,q=2,s=160,v=96,i=1,p=1,c=40,r=12,C=1"
+    ));
+    assert!(contains(&first, "kitty 160x96".as_bytes()));
+    assert!(
+        !contains(&s.draw(&a), b"\x1b_G"),
+        "the image did not change: not sent again"
+    );
+    // Measured as too slow at full resolution: a move renders at a lower one...
+    s.costs.seconds = Some(1e-5);
+    update(&mut a, Message::Walk(0.1));
+    assert!(s.needs_render(&a));
+    s.render(&a);
+    assert!(s.image.width < 160, "{}", s.image.width);
+    let moved = s.draw(&a);
+    assert!(
+        contains(&moved, b"c=40,r=12"),
+        "scaled up to the same cells"
+    );
+    assert!(s.upgrade_in(&a).is_some());
+    // ... and once nothing changes for SETTLE, at full resolution again.
+    s.changed_at -= SETTLE;
+    assert_eq!(s.upgrade_in(&a), Some(Duration::ZERO));
+    assert!(s.needs_render(&a));
+    s.render(&a);
+    assert_eq!((s.image.width, s.image.height), (160, 96));
+    assert_eq!(s.upgrade_in(&a), None);
+    assert!(!s.draw(&a).is_empty());
+    // The help is text: the image is deleted, and comes back whole when the help closes.
+    update(&mut a, Message::ToggleHelp);
+    s.render(&a);
+    let help = s.draw(&a);
+    assert!(contains(&help, raytty::frame::KITTY_DELETE_ALL));
+    assert!(contains(&help, b"raytty keys"));
+    update(&mut a, Message::ToggleHelp);
+    s.render(&a);
+    assert!(contains(&s.draw(&a), b"\x1b_Ga=T"));
+}
+
+/// sixel: the image is drawn one to one at the terminal's pixels (whole bands of six rows),
+/// and pixels off (G) goes back to text cells over a cleared screen.
+#[test]
+fn sixel_frames_are_full_size_and_g_goes_back_to_text() {
+    let mut a = pixel_app(Protocol::Sixel);
+    a.cell_pixels = (5, 9);
+    let mut s = Screen::new();
+    s.render(&a);
+    assert_eq!((s.image.width, s.image.height), (200, 108));
+    let first = s.draw(&a);
+    assert!(contains(&first, b"\x1b[H\x1bP0;1;0q\"1;1;200;108"));
+    assert!(contains(&first, "sixel 200x108".as_bytes()));
+    update(&mut a, Message::ToggleGraphics);
+    assert!(s.needs_render(&a));
+    s.render(&a);
+    let text = s.draw(&a);
+    assert!(contains(&text, b"\x1b[2J") && !contains(&text, b"\x1bP"));
+    assert_eq!(s.image.width, 40);
 }
