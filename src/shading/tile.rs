@@ -234,9 +234,8 @@ impl Tracer<'_> {
             };
             // Eight pixels all shaded here (most packets): copied as they are.
             if own == 0xff {
-                for (l, i) in g.idx[m..m + 8].iter_mut().enumerate() {
-                    *i = (8 * c + l) as u32;
-                }
+                g.idx[m..m + 8]
+                    .copy_from_slice(&std::array::from_fn::<u32, 8, _>(|l| (8 * c + l) as u32));
                 g.tri[m..m + 8].copy_from_slice(ids);
                 for a in 0..3 {
                     g.b[a][m..m + 8].copy_from_slice(&bary[a]);
@@ -274,28 +273,34 @@ impl Tracer<'_> {
         let tris = self.scene.triangles();
         let dirs = rays.dir_lanes();
         let chunks = m.div_ceil(w);
+        // Lanes past the last pixel repeat it (its triangle, index and barycentrics), so that
+        // every block reads whole lanes.
+        let end = chunks * w;
+        let last = m - 1;
+        for j in m..end {
+            g.tri[j] = g.tri[last];
+            g.idx[j] = g.idx[last];
+            for a in 0..3 {
+                g.b[a][j] = g.b[a][last];
+            }
+        }
         // Bit `c`: the pixels of block `c` are all on one triangle (the common case): its
         // values are splatted, else gathered lane by lane.
         let mut same = 0u64;
         for c in 0..chunks {
             let o = c * w;
-            let count = (m - o).min(w);
-            let tri = g.tri[o];
-            let one = match count {
+            let one = match w {
                 1 => true,
-                8 => g.tri[o..o + 8] == [tri; 8],
-                _ => g.tri[o..o + count].iter().all(|&t| t == tri),
+                _ => g.tri[o..o + 8] == [g.tri[o]; 8],
             };
             same |= (one as u64) << c;
         }
         for c in 0..chunks {
             let o = c * w;
             let count = (m - o).min(w);
-            // Lanes past the last pixel repeat it.
-            let lane = |l: usize| o + l.min(count - 1);
             let first = &tris[g.tri[o] as usize];
             let same = same >> c & 1 == 1;
-            let tri = |l: usize| &tris[g.tri[lane(l)] as usize];
+            let tri = |l: usize| &tris[g.tri[o + l] as usize];
             let v = each3!(|j| each3!(|a| match same {
                 true => s.splat(first.v[j][a]),
                 false => s.gather(|l| tri(l).v[j][a]),
@@ -309,7 +314,7 @@ impl Tracer<'_> {
             let in_place = g.idx[o + count - 1] as usize == o + count - 1 && o + 8 <= N;
             let dir = each3!(|a| match in_place {
                 true => s.load(block(&dirs[a], o)),
-                false => s.gather(|l| dirs[a][g.idx[lane(l)] as usize]),
+                false => s.gather(|l| dirs[a][g.idx[o + l] as usize]),
             });
             let b = each3!(|a| s.load(block(&g.b[a], o)));
             let at = surface(s, v, normal, b, dir);
@@ -336,15 +341,16 @@ impl Tracer<'_> {
             let sum = each3!(|a| s.load_at(&sum[a], o % 8));
             let colour = match self.settings.mode {
                 Mode::Colour => {
-                    let same = same >> c & 1 == 1;
                     let albedo = |l: usize| {
-                        let t = g.tri[o + l.min(count - 1)];
+                        let t = g.tri[o + l];
                         materials[tris[t as usize].material as usize].colour
                     };
-                    let rho = each3!(|a| match same {
-                        true => s.splat(albedo(0)[a]),
-                        false => s.gather(|l| albedo(l)[a]),
-                    });
+                    let rho = if same >> c & 1 == 1 {
+                        let rho = albedo(0);
+                        each3!(|a| s.splat(rho[a]))
+                    } else {
+                        each3!(|a| s.gather(|l| albedo(l)[a]))
+                    };
                     super::diffuse(s, rho, sum, [s.splat(indirect); 3])
                 }
                 _ => sum,
@@ -353,9 +359,14 @@ impl Tracer<'_> {
             each3!(|a| s.store(&mut rgb[a], colour[a]));
             let colour = |l: usize| Vec3::new(rgb[0][l], rgb[1][l], rgb[2][l]);
             if g.idx[o + count - 1] as usize == o + count - 1 {
-                // These pixels in place (indices only grow): written in a row.
-                for (l, out) in out[o..o + count].iter_mut().enumerate() {
-                    *out = colour(l);
+                // These pixels in place (indices only grow): written in a row (eight of them
+                // the common case, unrolled).
+                if let Ok(row) = <&mut [Vec3; 8]>::try_from(&mut out[o..o + count]) {
+                    *row = std::array::from_fn(colour);
+                } else {
+                    for (l, out) in out[o..o + count].iter_mut().enumerate() {
+                        *out = colour(l);
+                    }
                 }
             } else {
                 for l in 0..count {
