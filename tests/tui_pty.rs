@@ -820,6 +820,11 @@ fn a_terminal_that_lists_sixel_and_tells_its_size_gets_sixel_frames() {
     s.answer_queries(b"\x1b[?63;1;2;4;6;9;15;22c");
     s.wait_for_status(&["sixel 360x144"]);
     assert!(find(&s.raw, b"\x1b[H\x1bP0;1;0q\"1;1;360;144").is_some());
+    // A terminal that draws no sixel image over 300×300 (XTSMGRAPHICS) gets the same view in
+    // fewer pixels.
+    let mut small = Session::start_pixels(60, 13, (360, 156), false, &[], "xterm-256color");
+    small.answer_queries(b"\x1b[?2;0;300;300S\x1b[?63;1;2;4;6;9;15;22c");
+    small.wait_for_status(&["sixel 300x120"]);
     // G turns the pixels off: text cells, exactly the text frame.
     s.send(b"g");
     s.wait_for("the text frame", |scr| {

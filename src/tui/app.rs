@@ -83,6 +83,8 @@ pub struct App {
     pub pixels: bool,
     /// A cell's size in pixels (width, height): the pixel modes render at it.
     pub cell_pixels: (u32, u32),
+    /// The largest sixel image the terminal draws (width, height), if it said.
+    pub sixel_max: Option<(u32, u32)>,
     /// Pixel escapes go through tmux's passthrough.
     pub tmux: bool,
     /// Whether the key help covers the frame.
@@ -115,6 +117,7 @@ impl App {
             protocol: None,
             pixels: false,
             cell_pixels: super::detect::FALLBACK_CELL,
+            sixel_max: None,
             tmux: false,
             help: false,
             denoise: true,

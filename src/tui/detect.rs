@@ -11,6 +11,8 @@
 //! - the cell size in pixels: `CSI 16 t` (answered `CSI 6;h;w t`), else the text area
 //!   `CSI 14 t` (`CSI 4;h;w t`) over the grid; the caller prefers `TIOCGWINSZ`'s pixel fields
 //!   when the terminal fills them.
+//! - the largest sixel image: XTSMGRAPHICS (`CSI ? 2;1 S`, answered `CSI ? 2;0;w;h S`): xterm
+//!   draws nothing of a larger one (its default limit is 1000×1000).
 //!
 //! DA1 goes last: every terminal answers it, and in order, so its answer means no other
 //! answer is still on its way. Inside tmux the kitty query goes to the outer terminal through
@@ -78,7 +80,7 @@ pub fn queries(tmux: bool) -> Vec<u8> {
     } else {
         out.extend_from_slice(kitty.as_bytes());
     }
-    out.extend_from_slice(b"\x1b[16t\x1b[14t\x1b[c");
+    out.extend_from_slice(b"\x1b[16t\x1b[14t\x1b[?2;1S\x1b[c");
     out
 }
 
@@ -97,6 +99,8 @@ pub struct Answers {
     pub cell: Option<(u32, u32)>,
     /// The text area in pixels (width, height), from `CSI 14 t`.
     pub area: Option<(u32, u32)>,
+    /// The largest sixel image in pixels (width, height), from XTSMGRAPHICS.
+    pub sixel_max: Option<(u32, u32)>,
     /// Bytes that were not answers (keys typed meanwhile), in order, for the key parser.
     pub other: Vec<u8>,
     /// An incomplete sequence kept for the next feed.
@@ -202,6 +206,15 @@ impl Answers {
             self.sixel |= attrs.split(';').skip(1).any(|a| a == "4");
             return true;
         }
+        if f == b'S'
+            && let Some(rest) = params.strip_prefix('?')
+        {
+            let n: Vec<Option<u32>> = rest.split(';').map(|v| v.parse().ok()).collect();
+            if let [Some(2), Some(0), Some(w), Some(h)] = n.as_slice() {
+                self.sixel_max = Some((*w, *h)).filter(|&(w, h)| w >= 16 && h >= 16);
+            }
+            return true;
+        }
         if f != b't' {
             return false;
         }
@@ -294,8 +307,9 @@ mod tests {
 
     #[test]
     fn sixel_needs_attribute_4_and_a_known_cell() {
-        let a = fed(&[b"\x1b[4;780;1200t\x1b[?63;1;2;4;6;9;15;22c"]);
+        let a = fed(&[b"\x1b[4;780;1200t\x1b[?2;0;1000;1000S\x1b[?63;1;2;4;6;9;15;22c"]);
         assert_eq!(a.cell_size(120, 39), Some((10, 20)));
+        assert_eq!(a.sixel_max, Some((1000, 1000)));
         assert_eq!(choose(Choice::Auto, &a, true), Some(Protocol::Sixel));
         assert_eq!(choose(Choice::Auto, &a, false), None);
         // "4" must be an attribute, not the class (`?4c` is not a VT340).

@@ -30,14 +30,34 @@ pub const SETTLE: Duration = Duration::from_millis(80);
 pub const FIRST_PIXELS: u64 = 200_000;
 
 /// The size in pixels of the image on a `cols × rows` terminal of `cell`-pixel cells, the
-/// last row being the status line. Sixel draws six rows a band, and some terminals clear a
-/// whole band: its height is cut to a multiple of six so it never reaches the status line.
-pub fn full_size(protocol: Protocol, size: (u16, u16), cell: (u32, u32)) -> (u32, u32) {
+/// last row being the status line. Sixel draws one to one, so a sixel image larger than the
+/// terminal's `sixel_max` (xterm draws nothing of one) is shrunk to fit it, the same view
+/// over fewer pixels; and as it draws six rows a band, and some terminals clear a whole band,
+/// its height is cut to a multiple of six so it never reaches the status line.
+pub fn full_size(
+    protocol: Protocol,
+    size: (u16, u16),
+    cell: (u32, u32),
+    sixel_max: Option<(u32, u32)>,
+) -> (u32, u32) {
     let (cols, rows) = (u32::from(size.0), u32::from(size.1).saturating_sub(1));
     let (w, h) = (cols * cell.0, rows * cell.1);
     match protocol {
         Protocol::Kitty => (w, h),
-        Protocol::Sixel => (w, h / 6 * 6),
+        Protocol::Sixel => {
+            let (mw, mh) = sixel_max.unwrap_or((u32::MAX, u32::MAX));
+            let (w, h) = if w > mw || h > mh {
+                // The larger of the two shrink factors, w·mh vs h·mw (exact in u64).
+                if u64::from(w) * u64::from(mh) >= u64::from(h) * u64::from(mw) {
+                    (mw, (u64::from(h) * u64::from(mw) / u64::from(w)) as u32)
+                } else {
+                    ((u64::from(w) * u64::from(mh) / u64::from(h)) as u32, mh)
+                }
+            } else {
+                (w, h)
+            };
+            (w.max(1), (h / 6 * 6).max(6))
+        }
     }
 }
 
@@ -133,8 +153,24 @@ mod tests {
 
     #[test]
     fn sixel_keeps_whole_bands_above_the_status_line() {
-        assert_eq!(full_size(Protocol::Kitty, (120, 40), (10, 21)), (1200, 819));
-        assert_eq!(full_size(Protocol::Sixel, (120, 40), (10, 21)), (1200, 816));
+        let limit = Some((1000, 1000));
+        assert_eq!(
+            full_size(Protocol::Kitty, (120, 40), (10, 21), limit),
+            (1200, 819)
+        );
+        assert_eq!(
+            full_size(Protocol::Sixel, (120, 40), (10, 21), None),
+            (1200, 816)
+        );
+        // Over xterm's limit: the same view, shrunk to fit.
+        assert_eq!(
+            full_size(Protocol::Sixel, (120, 40), (10, 21), limit),
+            (1000, 678)
+        );
+        assert_eq!(
+            full_size(Protocol::Sixel, (50, 101), (10, 20), limit),
+            (250, 1000 / 6 * 6)
+        );
         assert_eq!(scaled((1200, 816), 3), (400, 272));
         assert_eq!(scaled((5, 5), 8), (1, 1));
     }

@@ -54,10 +54,14 @@ const MAX_PACING_WAIT: Duration = Duration::from_millis(250);
 /// outstanding (an answer arriving after the restore would be echoed on the shell's line).
 const QUIT_ACK_WAIT: Duration = Duration::from_millis(300);
 /// How long the start waits for the terminal's answers to the graphics queries. Every
-/// terminal answers the DA1 that ends them at once (over ssh, a round trip later), so this is
-/// waited out only by one that answers nothing, or inside tmux (whose passthrough may bring
-/// no answer at all).
-const DETECT_TIMEOUT: Duration = Duration::from_millis(400);
+/// terminal answers the DA1 that ends them (over ssh, a round trip later), so this is waited
+/// out only by one that answers nothing. Generous: kitty drawing in software on a loaded
+/// machine took longer than 400 ms to answer its first queries.
+const DETECT_TIMEOUT: Duration = Duration::from_millis(1000);
+/// Inside tmux, how long after tmux's own DA1 answer the outer terminal's answer to the kitty
+/// query is waited for (tmux 3.3a with allow-passthrough on, in kitty: 7 ms; with passthrough
+/// off, none ever comes).
+const TMUX_ANSWER_WAIT: Duration = Duration::from_millis(250);
 
 /// Queries written and not answered yet (the writer adds, the reader takes away).
 static UNANSWERED: AtomicUsize = AtomicUsize::new(0);
@@ -161,6 +165,7 @@ pub fn run(scene: Scene, color: ColorMode, cells: CellMode, graphics: Choice) ->
     app.protocol = found.protocol;
     app.pixels = found.protocol.is_some();
     app.cell_pixels = found.cell;
+    app.sixel_max = found.sixel_max;
     app.tmux = tmux;
     if found.protocol == Some(Protocol::Kitty) {
         tty::kitty_images(tmux);
@@ -189,6 +194,8 @@ struct Found {
     cell: (u32, u32),
     /// Bytes read meanwhile that were not answers: keys, for the reader.
     keys: Vec<u8>,
+    /// The largest sixel image, if the terminal said.
+    sixel_max: Option<(u32, u32)>,
 }
 
 /// Asks the terminal what it can show (see [`detect`]), unless `choice` is none, and reads
@@ -200,9 +207,14 @@ fn detect(input: RawFd, choice: Choice, size: (u16, u16), tmux: bool) -> Found {
         ws.and_then(|w| detect::cell_from_winsize(w.ws_col, w.ws_row, w.ws_xpixel, w.ws_ypixel));
     let mut answers = Answers::default();
     if choice != Choice::None && tty::write_now(&detect::queries(tmux), DETECT_TIMEOUT) {
-        let deadline = Instant::now() + DETECT_TIMEOUT;
+        let mut deadline = Instant::now() + DETECT_TIMEOUT;
         let mut buf = [0u8; 1024];
+        let mut da1 = false;
         while !answers.done(tmux) {
+            if answers.da1 && !da1 {
+                da1 = true;
+                deadline = deadline.min(Instant::now() + TMUX_ANSWER_WAIT);
+            }
             let left = deadline.saturating_duration_since(Instant::now());
             if left.is_zero() || !tty::wait_readable(input, Some(left)) {
                 break;
@@ -221,6 +233,7 @@ fn detect(input: RawFd, choice: Choice, size: (u16, u16), tmux: bool) -> Found {
         protocol: detect::choose(choice, &answers, cell.is_some()),
         cell: cell.unwrap_or(detect::FALLBACK_CELL),
         keys: answers.take_other(),
+        sixel_max: answers.sixel_max,
     }
 }
 

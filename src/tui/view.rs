@@ -204,7 +204,7 @@ impl Screen {
         match app.graphics() {
             None => Some(size),
             Some(p) => Some(pixels::scaled(
-                pixels::full_size(p, app.size, app.cell_pixels),
+                pixels::full_size(p, app.size, app.cell_pixels, app.sixel_max),
                 self.scale,
             )),
         }
@@ -220,7 +220,7 @@ impl Screen {
         };
         if self.generation != Some(app.generation) {
             self.changed_at = Instant::now();
-            let full = pixels::full_size(p, app.size, app.cell_pixels);
+            let full = pixels::full_size(p, app.size, app.cell_pixels, app.sixel_max);
             self.scale = pixels::moving_scale(full, self.costs, self.link.budget);
         } else if self.upgrade_in(app) == Some(Duration::ZERO) {
             self.scale = 1;
@@ -425,7 +425,7 @@ impl Screen {
         if !self.image_sent {
             let shown = app.scene.tone_map().image(&self.image);
             let (w, h) = (self.image.width, self.image.height);
-            let full = pixels::full_size(p, app.size, app.cell_pixels);
+            let full = pixels::full_size(p, app.size, app.cell_pixels, app.sixel_max);
             let cells = (u32::from(app.size.0), u32::from(app.size.1) - 1);
             let before = out.len();
             pixels::frame_bytes(p, &shown.to_rgb8(), (w, h), full, cells, app.tmux, &mut out);
