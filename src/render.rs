@@ -25,7 +25,7 @@ use crate::geometry::Ray;
 use crate::image::Image;
 use crate::sampler::{Sampler, Stream};
 use crate::scene::{PointLight, Scene};
-use crate::shading::{RayCounts, Settings, Stage, Tracer};
+use crate::shading::{PathRun, RayCounts, Settings, Stage, Tracer};
 
 /// The side of a tile of camera rays traced together (`TILE`² = [`crate::accel::TILE_RAYS`]).
 const TILE: usize = 8;
@@ -112,6 +112,8 @@ pub struct FrameStats {
     pub samples: u32,
     /// Wall-clock time of the render.
     pub elapsed: Duration,
+    /// What the physically based path ran (`None`: the seed's shading).
+    pub path: Option<PathRun>,
 }
 
 /// A rendered frame.
@@ -286,6 +288,7 @@ fn render(scene: &Scene, options: &Options, cache: Option<&mut HitCache>) -> Fra
             rays,
             samples: job.samples,
             elapsed: start.elapsed(),
+            path: job.tracer.path_run(),
         },
         guides,
     };
@@ -308,11 +311,15 @@ impl FrameStats {
         }
     }
 
-    /// One line for people: time, samples, rays by kind, M rays/s and the SIMD path.
+    /// One line for people: time, samples, rays by kind, M rays/s and the SIMD path, and the
+    /// physically based effects where the frame ran them.
     pub fn summary(&self, isa: crate::accel::Isa) -> String {
         let rays = self.rays.by_kind().map(|(kind, n)| format!("{n} {kind}"));
+        let effects = self.path.map_or(String::new(), |p| {
+            format!("; effects: {}", p.names().join(", "))
+        });
         format!(
-            "{:.2} ms, {} spp, rays: {}; {:.2} M rays/s ({}, {} threads)",
+            "{:.2} ms, {} spp, rays: {}; {:.2} M rays/s ({}, {} threads){effects}",
             self.elapsed.as_secs_f64() * 1e3,
             self.samples,
             rays.join(", "),
@@ -322,15 +329,19 @@ impl FrameStats {
         )
     }
 
-    /// The same as one JSON object: `ms`, `spp`, `rays` (by kind), `mrays_per_s`, and the
-    /// `simd` path and `threads`.
+    /// The same as one JSON object: `ms`, `spp`, `rays` (by kind), `mrays_per_s`, the
+    /// `simd` path and `threads`, and `effects` (names) where the physically based path ran.
     pub fn to_json(&self, isa: crate::accel::Isa) -> String {
         let rays = self
             .rays
             .by_kind()
             .map(|(kind, n)| format!("\"{kind}\":{n}"));
+        let effects = self.path.map_or(String::new(), |p| {
+            let names: Vec<String> = p.names().iter().map(|n| format!("\"{n}\"")).collect();
+            format!(",\"effects\":[{}]", names.join(","))
+        });
         format!(
-            "{{\"ms\":{:.3},\"spp\":{},\"rays\":{{{}}},\"mrays_per_s\":{:.3},\"simd\":\"{}\",\"threads\":{}}}",
+            "{{\"ms\":{:.3},\"spp\":{},\"rays\":{{{}}},\"mrays_per_s\":{:.3},\"simd\":\"{}\",\"threads\":{}{effects}}}",
             self.elapsed.as_secs_f64() * 1e3,
             self.samples,
             rays.join(","),

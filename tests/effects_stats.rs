@@ -175,8 +175,8 @@ fn mirrored_box() -> Scene {
     let mut b = SceneBuilder::new();
     let white = b.material(Material::diffuse(Vec3::splat(0.75)));
     let glass = b.material(Material {
-        colour: Vec3::splat(0.75),
         mirror: 1.0,
+        ..Material::diffuse(Vec3::splat(0.75))
     });
     let v = |x, y, z| Vec3::new(x, y, z);
     b.object(
@@ -366,8 +366,8 @@ fn wall_of(material: Material) -> Scene {
 fn a_perfect_mirror_or_a_black_surface_traces_no_shadow_or_bounce_ray() {
     let px = u64::from(W * H);
     let mirror = |m| Material {
-        colour: Vec3::splat(0.75),
         mirror: m,
+        ..Material::diffuse(Vec3::splat(0.75))
     };
     for indirect in [Indirect::Constant(0.5), GI4] {
         let s = stats(&wall_of(mirror(1.0)), &settings(true, indirect, 1));

@@ -201,6 +201,7 @@ impl RowKind {
                     sampler: scene.effects().sampler,
                 },
                 frame: 0,
+                estimator: crate::shading::Estimator::Auto,
             },
             RowKind::Independent { spp } => {
                 let mut s = RowKind::Gi {

@@ -87,6 +87,7 @@ impl ReferenceSpec {
                 sampler: Sampler::Independent,
             },
             frame: FRAME_BASE + pass,
+            estimator: crate::shading::Estimator::Auto,
         }
     }
 }

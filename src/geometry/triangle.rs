@@ -68,6 +68,15 @@ impl Triangle {
         })
     }
 
+    /// The unit normal of the side the vertices' counter-clockwise winding faces in a
+    /// right-handed frame, `−normal`: a closed mesh wound the usual way (and the `box` and
+    /// `icosphere` objects) has it pointing out. An emitter emits on this side, and glass has
+    /// air on it.
+    #[inline]
+    pub fn front(&self) -> Vec3 {
+        -self.normal
+    }
+
     /// Intersects `ray` with this triangle (both sides), returning a hit with `0 < t < t_max`.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<TriHit> {

@@ -2,11 +2,12 @@
 //! Picking one light of many in proportion to its power ([`AliasTable`]), a point uniformly
 //! on an emitting triangle ([`sample_triangle`]), and the change of a density per area into
 //! one per solid angle as seen from the shaded point ([`area_to_solid_angle`]).
-//!
-//! Not yet used by the shading path (today's scenes have point lights only).
+//! [`AreaLights`] puts them together for a scene's emitting triangles.
 
 mod alias;
 mod area;
+mod emitters;
 
 pub use alias::AliasTable;
 pub use area::{TrianglePoint, area_to_solid_angle, sample_triangle};
+pub use emitters::{AreaLights, LightPoint};

@@ -9,8 +9,8 @@
 //! `η²`, so a transmitting BSDF's `f` includes that factor. `f` does not include the cosine
 //! `|wi.z|`; an estimator multiplies it in.
 //!
-//! Not yet used by the shading path: the materials of today's scenes (diffuse and the perfect
-//! mirror) are shaded there, and these types are what the one shading path will ask.
+//! [`SurfaceBsdf`] is a scene's [`crate::scene::Material`] as the weighted sum of these; the
+//! path tracer of physically based scenes asks it only.
 
 mod conductor;
 mod dielectric;
@@ -19,6 +19,7 @@ mod ggx;
 mod lambertian;
 mod mirror;
 mod rough_dielectric;
+mod surface;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
@@ -27,6 +28,7 @@ pub use ggx::Ggx;
 pub use lambertian::Lambertian;
 pub use mirror::Mirror;
 pub use rough_dielectric::RoughDielectric;
+pub use surface::SurfaceBsdf;
 
 use glam::{Vec2, Vec3};
 

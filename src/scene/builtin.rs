@@ -18,7 +18,7 @@ pub struct Builtin {
 }
 
 /// All built-in scenes; the first is the default.
-pub const BUILTINS: [Builtin; 4] = [
+pub const BUILTINS: [Builtin; 7] = [
     Builtin {
         name: "cornell",
         description: "the seed's Cornell box: one light, no mirrors (the default)",
@@ -42,6 +42,24 @@ pub const BUILTINS: [Builtin; 4] = [
         description: "a displaced icosphere of 1,003,520 triangles in the Cornell room",
         triangles: 1_003_530,
         source: include_str!("../../scenes/sphere.toml"),
+    },
+    Builtin {
+        name: "area",
+        description: "the Cornell box lit by a square area light in the ceiling: soft shadows",
+        triangles: 32,
+        source: include_str!("../../scenes/area.toml"),
+    },
+    Builtin {
+        name: "glass",
+        description: "a smooth glass ball and a frosted glass block under an area light: refraction",
+        triangles: 2904,
+        source: include_str!("../../scenes/glass.toml"),
+    },
+    Builtin {
+        name: "plates",
+        description: "metal plates of four roughnesses under four lights of four sizes (after Veach): MIS",
+        triangles: 732,
+        source: include_str!("../../scenes/plates.toml"),
     },
 ];
 
@@ -82,7 +100,7 @@ mod tests {
 
     #[test]
     fn small_built_ins_load_with_their_stated_triangle_counts() {
-        for b in BUILTINS.iter().filter(|b| b.triangles < 1000) {
+        for b in BUILTINS.iter().filter(|b| b.triangles < 10_000) {
             let scene = b.load().unwrap_or_else(|e| panic!("{}: {e}", b.name));
             assert_eq!(scene.triangles.len(), b.triangles, "{}", b.name);
             assert_eq!(scene.name, b.name);

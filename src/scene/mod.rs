@@ -19,6 +19,7 @@ use crate::accel::{Accel, AccelKind, AccelStats, Hit, Isa, TileCache};
 use crate::camera::Camera;
 use crate::geometry::{Aabb, DegenerateTriangle, Ray, RayTile, Triangle};
 use crate::image::ToneMap;
+use crate::light::AreaLights;
 use crate::sampler::Sampler;
 
 /// Largest absolute coordinate accepted anywhere a user gives one (scene files, OBJ vertices,
@@ -27,14 +28,39 @@ use crate::sampler::Sampler;
 pub const MAX_COORDINATE: f32 = 1e6;
 
 /// A surface's material.
+///
+/// Its parts are layered, each taking a fraction of what the layers above it leave (see
+/// [`crate::material::SurfaceBsdf`]): the seed's perfect mirror (`mirror`), a GGX metal of
+/// colour `colour` (`metal`), glass (`transmission`, tinted by `colour`), and a Lambertian
+/// base of colour `colour` under them. A surface may also emit (`emission`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
-    /// Diffuse reflectance ρ, linear RGB.
+    /// The base colour, linear RGB in `[0, 1]`: the diffuse reflectance ρ, a metal's
+    /// reflectance at normal incidence, glass's transmittance. [`Scene::base_colour`] is the
+    /// one place it is read for a hit.
     pub colour: Vec3,
     /// Mirror reflectance in `[0, 1]`: the fraction of light reflected specularly. 0 is a
     /// purely diffuse surface, for which no reflection ray is ever traced.
     pub mirror: f32,
+    /// The fraction in `[0, 1]` that is a GGX conductor (of F0 = colour); 0 is none.
+    pub metal: f32,
+    /// Perceptual roughness in `[0, 1]` of the metal and the glass (GGX α = roughness²; 0 is
+    /// smooth).
+    pub roughness: f32,
+    /// The glass's index of refraction, in `[1, MAX_IOR]` (1.5 by default).
+    pub ior: f32,
+    /// The fraction in `[0, 1]` of what the metal leaves that is glass (refracts).
+    pub transmission: f32,
+    /// What the surface emits from its front face ([`Triangle::front`]: the side its
+    /// counter-clockwise winding faces),
+    /// per channel, in the image's units: a camera sees an emitter of emission `e` as the
+    /// pixel value `e` (radiance × π, the seed's units). Zero for a surface that does not
+    /// emit.
+    pub emission: Vec3,
 }
+
+/// The largest index of refraction a material may have (diamond's is 2.42).
+pub const MAX_IOR: f32 = 4.0;
 
 impl Material {
     /// A purely diffuse material.
@@ -42,7 +68,29 @@ impl Material {
         Material {
             colour,
             mirror: 0.0,
+            metal: 0.0,
+            roughness: 0.0,
+            ior: 1.5,
+            transmission: 0.0,
+            emission: Vec3::ZERO,
         }
+    }
+
+    /// Whether the surface emits light.
+    pub fn emits(&self) -> bool {
+        self.emission.max_element() > 0.0
+    }
+
+    /// Whether every value is in its range (what [`SceneBuilder::build`] checks).
+    fn is_valid(&self) -> bool {
+        let unit = |x: f32| (0.0..=1.0).contains(&x);
+        unit(self.mirror)
+            && unit(self.metal)
+            && unit(self.roughness)
+            && unit(self.transmission)
+            && (1.0..=MAX_IOR).contains(&self.ior)
+            && self.emission.is_finite()
+            && self.emission.min_element() >= 0.0
     }
 }
 
@@ -112,6 +160,8 @@ pub struct Scene {
     /// The objects as added (ranges of `triangles`), for rebuilding the flat list.
     objects: Vec<Range<usize>>,
     has_mirrors: bool,
+    /// The emitting triangles, picked by power; `None` when nothing emits.
+    area_lights: Option<AreaLights>,
     default_lights: bool,
     step: f32,
     tone_map: ToneMap,
@@ -133,6 +183,11 @@ pub enum SceneError {
         /// Index of the triangle.
         index: usize,
     },
+    /// A material has a value out of its range (see [`Material`]'s fields).
+    MaterialValue {
+        /// Index of the material.
+        index: usize,
+    },
     /// A light has a non-finite position or a negative or non-finite power.
     Light {
         /// Index of the light.
@@ -145,6 +200,10 @@ impl std::fmt::Display for SceneError {
         match self {
             SceneError::Triangle { index, problem } => write!(f, "triangle {index}: {problem}"),
             SceneError::Material { index } => write!(f, "triangle {index}: unknown material"),
+            SceneError::MaterialValue { index } => write!(
+                f,
+                "material {index}: a value is out of range (fractions and roughness from 0 to 1, ior from 1 to {MAX_IOR}, emission finite and non-negative)"
+            ),
             SceneError::Light { index } => write!(
                 f,
                 "light {index}: position must be finite and power finite and non-negative"
@@ -301,6 +360,9 @@ impl SceneBuilder {
         if let Some(index) = first_bad {
             return Err(SceneError::Material { index });
         }
+        if let Some(index) = self.materials.iter().position(|m| !m.is_valid()) {
+            return Err(SceneError::MaterialValue { index });
+        }
         if let Some(index) = self.lights.iter().position(|l| {
             !l.position.is_finite() || !l.power.is_finite() || l.power.min_element() < 0.0
         }) {
@@ -329,6 +391,13 @@ impl SceneBuilder {
         drop(self.raw);
         let accel = Accel::build_kind(&triangles, &objects, kind);
         let has_mirrors = self.materials.iter().any(|m| m.mirror > 0.0);
+        // Only a scene with an emitting material looks for emitting triangles.
+        let area_lights = if self.materials.iter().any(Material::emits) {
+            let materials = &self.materials;
+            AreaLights::new(&triangles, |t| materials[t.material as usize].emission)
+        } else {
+            None
+        };
         Ok(Scene {
             name: name.to_string(),
             triangles,
@@ -344,6 +413,7 @@ impl SceneBuilder {
             accel,
             objects,
             has_mirrors,
+            area_lights,
             default_lights: self.default_lights,
             step: self
                 .step
@@ -525,6 +595,19 @@ impl Scene {
     /// The object (in the order added) that triangle `triangle` belongs to.
     pub fn object_of(&self, triangle: u32) -> u32 {
         self.objects.partition_point(|r| r.end <= triangle as usize) as u32
+    }
+
+    /// The base colour at a hit on `triangle` at barycentrics `b`: the one place a hit's colour
+    /// is looked up (today the material's constant colour; textures would be read here).
+    #[inline]
+    pub fn base_colour(&self, triangle: u32, b: [f32; 3]) -> Vec3 {
+        let _ = b;
+        self.materials[self.triangles[triangle as usize].material as usize].colour
+    }
+
+    /// The emitting triangles as lights, picked by power (`None` when nothing emits).
+    pub fn area_lights(&self) -> Option<&AreaLights> {
+        self.area_lights.as_ref()
     }
 
     /// Whether any material reflects specularly (if not, no reflection ray is ever traced).

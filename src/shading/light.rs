@@ -1,11 +1,59 @@
-//! What a light gives a surface, in lanes: one function per kind of light (today the point
-//! light), written once over [`Lanes`] so that one ray at a time is width 1.
+//! What a light gives a surface: one function per kind of light. The point light's is
+//! written once over [`Lanes`] (the tile kernel's), so that one ray at a time is width 1; the
+//! area light's (emitting triangles, path-traced frames only) is one point at a time.
 
 use std::f32::consts::PI;
 
-use super::lane::{Lanes, each3};
+use glam::{Vec2, Vec3};
+
+use super::lane::{Lanes, Scalar, each3};
 use super::surface::{Surface, dot, offset_origin};
-use crate::scene::PointLight;
+use crate::geometry::Ray;
+use crate::light::{AreaLights, area_to_solid_angle};
+use crate::scene::{PointLight, Scene};
+
+/// A point drawn on the area lights, as seen from a shaded point.
+pub(crate) struct AreaIncident {
+    /// The unit direction toward it.
+    pub wi: Vec3,
+    /// The density per solid angle of having drawn it.
+    pub pdf: f32,
+    /// What its front face emits toward the point.
+    pub emission: Vec3,
+    /// The shadow ray: from the offset point to the light point, blocked if anything is hit
+    /// before `t = 1 − SHADOW_EPSILON`.
+    pub shadow: Ray,
+}
+
+/// One of `lights` picked by power with `u`, a point on it by area with `uv`, seen from the
+/// point `at`: `None` where the light's back faces the point or is edge-on (it sends nothing
+/// there, and no shadow ray is traced).
+pub(crate) fn area_light(
+    scene: &Scene,
+    lights: &AreaLights,
+    at: &Surface<f32>,
+    u: f32,
+    uv: Vec2,
+) -> Option<AreaIncident> {
+    let tris = scene.triangles();
+    let lp = lights.sample(tris, u, uv)?;
+    let tri = &tris[lp.triangle as usize];
+    let p = Vec3::from_array(at.p);
+    let d = lp.position - p;
+    // Only the light's front face emits.
+    if !(d.dot(tri.front()) < 0.0) {
+        return None;
+    }
+    let pdf = area_to_solid_angle(lp.pdf_area, p, lp.position, tri.front())?;
+    let wi = d.normalize();
+    let origin = Vec3::from_array(offset_origin(Scalar, at, wi.to_array()));
+    Some(AreaIncident {
+        wi,
+        pdf,
+        emission: scene.materials()[tri.material as usize].emission,
+        shadow: Ray::new(origin, lp.position - origin),
+    })
+}
 
 /// One light's contribution at a [`Surface`]'s points, one per lane.
 pub(crate) struct Incident<F> {

@@ -10,12 +10,13 @@ use crate::accel::Hit;
 use crate::accel::tri4::Best8;
 use crate::geometry::{Ray, RayTile, Triangle};
 use crate::sampler::SampleSource;
-use crate::scene::{Indirect, Material, PointLight, Scene};
+use crate::scene::{Indirect, PointLight, Scene};
 
 mod lane;
 mod light;
 #[cfg(target_arch = "x86_64")]
 mod packets;
+mod path;
 mod split;
 mod stage;
 mod surface;
@@ -24,6 +25,7 @@ mod tile;
 use lane::{Lanes, Scalar};
 use surface::{Surface, offset_origin, surface};
 
+pub use path::{Estimator, PathEffects, PathRun};
 pub use split::{GuideHit, SplitSample};
 pub use stage::{Mode, RayCounts, Settings, Stage};
 
@@ -57,6 +59,10 @@ pub struct Tracer<'a> {
     lights: &'a [PointLight],
     settings: Settings,
     min_r2: f32,
+    /// What the scene calls for of the physically based path ([`path`]).
+    path_effects: PathEffects,
+    /// The estimator the frame's settings resolve to for this scene.
+    estimator: Estimator,
     /// Per light, the shadow cull of a small scene's tiles, built on first use.
     #[cfg(target_arch = "x86_64")]
     culls: std::sync::OnceLock<Vec<crate::accel::shadow::ShadowCull>>,
@@ -66,11 +72,14 @@ impl<'a> Tracer<'a> {
     /// A tracer of `scene` lit by `lights` (which may differ from the scene's own).
     pub fn new(scene: &'a Scene, lights: &'a [PointLight], settings: Settings) -> Tracer<'a> {
         let r = scene.min_light_distance();
+        let path_effects = PathEffects::of(scene);
         Tracer {
             scene,
             lights,
             settings,
             min_r2: r * r,
+            path_effects,
+            estimator: path_effects.estimator(settings.estimator),
             #[cfg(target_arch = "x86_64")]
             culls: std::sync::OnceLock::new(),
         }
@@ -85,7 +94,11 @@ impl<'a> Tracer<'a> {
         n: &mut RayCounts,
     ) -> Vec3 {
         let Some(hit) = hit else { return Vec3::ZERO };
-        let c = self.shade(ray, &hit, 0, 0, rng, n);
+        let c = if self.physical() {
+            self.path(ray, &hit, rng, n)
+        } else {
+            self.shade(ray, &hit, 0, 0, rng, n)
+        };
         debug_assert!(c.is_finite(), "non-finite colour {c}");
         c
     }
@@ -139,20 +152,33 @@ impl<'a> Tracer<'a> {
         }
         let at = surface_of(tri, hit, ray);
         let (p, normal) = (Vec3::from_array(at.p), Vec3::from_array(at.normal));
+        if self.physical() {
+            // Not split yet: the whole path is left to the denoiser's `rest`.
+            return SplitSample {
+                rest: self.path(ray, hit, rng, n),
+                guide: Some(GuideHit {
+                    position: p,
+                    normal,
+                    object: self.scene.object_of(hit.triangle),
+                    reflections: mirror_depth,
+                }),
+                ..SplitSample::default()
+            };
+        }
+        let colour = self.scene.base_colour(hit.triangle, hit.b);
         let reflects = material.mirror > 0.0 && mirror_depth < MAX_MIRROR_DEPTH;
         // As in `shade`: a perfect mirror's own shading and a black surface's cost no ray.
-        let (direct, irradiance) =
-            if (reflects && material.mirror >= 1.0) || material.colour == Vec3::ZERO {
-                (Vec3::ZERO, Vec3::ZERO)
-            } else {
-                (
-                    self.direct_at(&at, n),
-                    self.indirect(material, &at, mirror_depth, 0, rng, n),
-                )
-            };
+        let (direct, irradiance) = if (reflects && material.mirror >= 1.0) || colour == Vec3::ZERO {
+            (Vec3::ZERO, Vec3::ZERO)
+        } else {
+            (
+                self.direct_at(&at, n),
+                self.indirect(colour, &at, mirror_depth, 0, rng, n),
+            )
+        };
         let own = SplitSample {
-            rest: material.colour * direct,
-            albedo: material.colour,
+            rest: colour * direct,
+            albedo: colour,
             irradiance,
             guide: Some(GuideHit {
                 position: p,
@@ -216,8 +242,9 @@ impl<'a> Tracer<'a> {
     ) -> Vec3 {
         let tri = &self.scene.triangles()[hit.triangle as usize];
         let material = &self.scene.materials()[tri.material as usize];
+        let colour = self.scene.base_colour(hit.triangle, hit.b);
         if self.settings.mode == Mode::Flat {
-            return material.colour;
+            return colour;
         }
         let at = surface_of(tri, hit, ray);
         if self.settings.mode == Mode::Irradiance {
@@ -226,25 +253,31 @@ impl<'a> Tracer<'a> {
         let reflects = material.mirror > 0.0 && mirror_depth < MAX_MIRROR_DEPTH;
         // What cannot change the pixel is not traced: a perfect mirror's own shading is
         // weighted by 1 − mirror = 0, and a black surface's by ρ = 0.
-        let diffuse = if (reflects && material.mirror >= 1.0) || material.colour == Vec3::ZERO {
+        let diffuse = if (reflects && material.mirror >= 1.0) || colour == Vec3::ZERO {
             Vec3::ZERO
         } else {
             let direct = self.direct_at(&at, n);
-            let indirect = self.indirect(material, &at, mirror_depth, bounce, rng, n);
+            let indirect = self.indirect(colour, &at, mirror_depth, bounce, rng, n);
             let [r, g, b] = diffuse(
                 Scalar,
-                material.colour.to_array(),
+                colour.to_array(),
                 direct.to_array(),
                 indirect.to_array(),
             );
             Vec3::new(r, g, b)
         };
-        if reflects {
+        let shaded = if reflects {
             n.reflection += 1;
             let reflected = self.trace(&mirror_ray(&at, ray), mirror_depth + 1, bounce, rng, n);
             diffuse * (1.0 - material.mirror) + reflected * material.mirror
         } else {
             diffuse
+        };
+        // (Only an emitter adds: `+ 0` would turn a −0 into +0.)
+        if material.emits() {
+            shaded + Tracer::emitted(tri, material, ray)
+        } else {
+            shaded
         }
     }
 
@@ -252,7 +285,7 @@ impl<'a> Tracer<'a> {
     /// bounce (with Russian roulette past [`ROULETTE_START`] bounces).
     fn indirect(
         &self,
-        material: &Material,
+        colour: Vec3,
         at: &Surface<f32>,
         mirror_depth: u32,
         bounce: u32,
@@ -267,7 +300,7 @@ impl<'a> Tracer<'a> {
                 // (the surface's albedo, which scales whatever comes back) and what it brings
                 // is divided by q, so the expected value is unchanged.
                 let q = if bounce >= ROULETTE_START {
-                    material.colour.max_element().clamp(MIN_SURVIVAL, 1.0)
+                    colour.max_element().clamp(MIN_SURVIVAL, 1.0)
                 } else {
                     1.0
                 };
@@ -298,9 +331,9 @@ impl<'a> Tracer<'a> {
     }
 
     /// Whether the tile kernel finishes a hit on `triangle` in lanes: in light-only frames
-    /// every hit, in colour frames a surface that is all diffuse ([`diffuse`]) and not black.
-    /// Mirrors and black surfaces (whose own shading costs no ray) and flat colour are shaded
-    /// one ray at a time.
+    /// every hit, in colour frames a surface that is all diffuse ([`diffuse`]), not black and
+    /// not emitting. Mirrors, black surfaces (whose own shading costs no ray), emitters and
+    /// flat colour are shaded one ray at a time.
     #[inline]
     fn in_lanes(&self, triangle: u32) -> bool {
         let tri = &self.scene.triangles()[triangle as usize];
@@ -308,7 +341,9 @@ impl<'a> Tracer<'a> {
         match self.settings.mode {
             Mode::Flat => false,
             Mode::Irradiance => true,
-            Mode::Colour => !(material.mirror > 0.0) && material.colour != Vec3::ZERO,
+            Mode::Colour => {
+                !(material.mirror > 0.0) && material.colour != Vec3::ZERO && !material.emits()
+            }
         }
     }
 

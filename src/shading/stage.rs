@@ -2,6 +2,7 @@
 //! frame traced, by kind.
 
 use super::GI_MAX_BOUNCES;
+use super::path::Estimator;
 use crate::scene::{Effects, Indirect};
 
 /// The seed's stages, selectable by name and by the keys 1-6.
@@ -85,6 +86,7 @@ impl Stage {
             mode,
             effects,
             frame: 0,
+            estimator: Estimator::Auto,
         }
     }
 }
@@ -109,6 +111,9 @@ pub struct Settings {
     pub effects: Effects,
     /// Frame number: seeds the random numbers (progressive refinement uses a new one per pass).
     pub frame: u32,
+    /// How the physically based path gathers light at vertices that are not specular (the
+    /// seed's shading ignores it).
+    pub estimator: Estimator,
 }
 
 /// Rays traced, by kind.

@@ -332,7 +332,6 @@ impl Tracer<'_> {
             Indirect::Constant(k) => k,
             _ => 0.0,
         };
-        let materials = self.scene.materials();
         debug_assert!(m <= k);
         for c in 0..chunks {
             let o = c * w;
@@ -342,8 +341,9 @@ impl Tracer<'_> {
             let colour = match self.settings.mode {
                 Mode::Colour => {
                     let albedo = |l: usize| {
-                        let t = g.tri[o + l];
-                        materials[tris[t as usize].material as usize].colour
+                        let j = o + l;
+                        let b = [g.b[0][j], g.b[1][j], g.b[2][j]];
+                        self.scene.base_colour(g.tri[j], b)
                     };
                     let rho = if same >> c & 1 == 1 {
                         let rho = albedo(0);

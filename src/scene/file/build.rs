@@ -16,7 +16,7 @@ use super::spec::{
 use super::*;
 use crate::camera::Camera;
 use crate::sampler::Sampler;
-use crate::scene::{Effects, Indirect, Material, PointLight, SceneBuilder};
+use crate::scene::{Effects, Indirect, MAX_IOR, Material, PointLight, SceneBuilder};
 use toml::Spanned;
 
 /// Parses `source` and builds its scene.
@@ -146,18 +146,50 @@ fn materials<'a>(
                 ),
             ));
         }
-        let mirror = match &m.mirror {
+        let fraction = |v: &Option<Spanned<f64>>, what: &str, default: f64| match v {
+            Some(r) => cx.ranged(r, 0.0, 1.0, &format!("material `{key}`: {what}")),
+            None => Ok(default),
+        };
+        let mirror = fraction(&m.mirror, "the mirror reflectance", 0.0)?;
+        let metal = fraction(&m.metal, "metal (the fraction that is metal)", 0.0)?;
+        let roughness = fraction(&m.roughness, "roughness", 0.0)?;
+        let transmission = fraction(
+            &m.transmission,
+            "transmission (the fraction that is glass)",
+            0.0,
+        )?;
+        let ior = match &m.ior {
             Some(r) => cx.ranged(
                 r,
-                0.0,
                 1.0,
-                &format!("material `{key}`: the mirror reflectance"),
+                f64::from(MAX_IOR),
+                &format!("material `{key}`: ior (the index of refraction; glass is 1.5)"),
             )?,
-            None => 0.0,
+            None => 1.5,
+        };
+        let emission = match &m.emission {
+            Some(e) => {
+                let NumberOrTriple(c) = *e.get_ref();
+                if let Some(bad) = c.iter().find(|c| !(**c >= 0.0 && **c <= MAX_EMISSION)) {
+                    return Err(cx.err_at(
+                        e,
+                        format!(
+                            "material `{key}`: emission {bad} is not allowed: expected a number from 0 to {MAX_EMISSION:e}, or [r, g, b] of such numbers (what the camera sees on the emitting face; 1 is white)"
+                        ),
+                    ));
+                }
+                Vec3::from(c.map(|c| c as f32))
+            }
+            None => Vec3::ZERO,
         };
         let material = Material {
             colour: Vec3::from(m.colour.get_ref().0.map(|c| c as f32)),
             mirror: mirror as f32,
+            metal: metal as f32,
+            roughness: roughness as f32,
+            ior: ior as f32,
+            transmission: transmission as f32,
+            emission,
         };
         out.insert(key.as_str(), material);
     }

@@ -28,6 +28,8 @@ pub const MAX_MESH_VERTICES: usize = 3 * MAX_TRIANGLES;
 pub const MAX_LIGHTS: usize = 16;
 /// Largest light power per channel.
 pub const MAX_POWER: f64 = 1e12;
+/// Largest emission per channel (in the image's units: 1 is a white a camera sees as 1).
+pub const MAX_EMISSION: f64 = 1e6;
 /// Largest samples per pixel.
 pub const MAX_SAMPLES: i64 = 1024;
 /// Largest number of path-traced bounces.

@@ -47,6 +47,11 @@ pub struct LightSpec {
 pub struct MaterialSpec {
     pub colour: Spanned<Three<f64>>,
     pub mirror: Option<Spanned<f64>>,
+    pub metal: Option<Spanned<f64>>,
+    pub roughness: Option<Spanned<f64>>,
+    pub ior: Option<Spanned<f64>>,
+    pub transmission: Option<Spanned<f64>>,
+    pub emission: Option<Spanned<NumberOrTriple>>,
 }
 
 /// One `[[object]]`: every kind's keys, checked against its `kind` after parsing.

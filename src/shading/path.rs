@@ -1,0 +1,355 @@
+//! Path tracing of physically based scenes: the materials of [`crate::material`] (asked only
+//! through [`SurfaceBsdf`]), emitting triangles as area lights, and the point lights. At each
+//! vertex, next-event estimation (each point light, exactly, as [`super::light::point_light`]
+//! gives it; one area light picked by power, one point on it, one shadow ray) and one BSDF
+//! sample to go on with; where the frame's [`Estimator`] says so, the two are combined by
+//! multiple importance sampling with the power heuristic (Veach 1997), so that light reaching a
+//! vertex is counted once.
+//!
+//! A frame runs this only where its scene calls for it ([`PathEffects::of`]): something emits,
+//! is metal or transmits. The seed's scenes keep the seed's shading (`super::Tracer::shade`).
+//!
+//! Units are the seed's (pixel values are π × radiance): a BSDF's value is multiplied by π
+//! under a point light (whose term is the seed's irradiance `P·cos/(4πr²)`), and an emitter's
+//! `emission` is what the camera sees.
+
+use std::f32::consts::PI;
+
+use glam::{Vec2, Vec3};
+
+use super::lane::Scalar;
+use super::light::{AreaIncident, area_light, point_light};
+use super::surface::offset_origin;
+use super::{MIN_SURVIVAL, Mode, ROULETTE_START, RayCounts, SHADOW_EPSILON, Tracer, surface_of};
+use crate::accel::Hit;
+use crate::geometry::{Ray, Triangle};
+use crate::light::area_to_solid_angle;
+use crate::material::{BsdfFlags, ShadingFrame, SurfaceBsdf};
+use crate::sampler::SampleSource;
+use crate::scene::{Indirect, Material, Scene};
+
+/// How light is gathered at vertices that are not specular.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Estimator {
+    /// What the scene calls for: MIS where something is glossy and something emits, else light
+    /// sampling alone (at a diffuse vertex BSDF sampling finds a small light rarely, and MIS
+    /// would trace the same rays for a weight near 1).
+    #[default]
+    Auto,
+    /// Next-event estimation only: emission found by a BSDF ray counts only after a specular
+    /// vertex (or the camera).
+    Light,
+    /// BSDF sampling only: emission counts wherever a path finds it; no area-light shadow ray.
+    Bsdf,
+    /// Both, weighted by the power heuristic.
+    Mis,
+}
+
+impl Estimator {
+    /// The names `--estimator` takes, in order: auto, light, bsdf, mis.
+    pub const ALL: [Estimator; 4] = [
+        Estimator::Auto,
+        Estimator::Light,
+        Estimator::Bsdf,
+        Estimator::Mis,
+    ];
+
+    /// The estimator's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Estimator::Auto => "auto",
+            Estimator::Light => "light",
+            Estimator::Bsdf => "bsdf",
+            Estimator::Mis => "mis",
+        }
+    }
+}
+
+/// What a physically based scene calls for, derived from its materials and lights.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PathEffects {
+    /// Some triangle emits: area lights are sampled.
+    pub area_lights: bool,
+    /// Some material is glossy (a rough metal or rough glass).
+    pub glossy: bool,
+    /// Some material refracts.
+    pub refraction: bool,
+    /// Some material is metal.
+    pub metal: bool,
+}
+
+impl PathEffects {
+    /// The effects `scene` calls for, from its materials' BSDF flags and its emitters.
+    pub fn of(scene: &Scene) -> PathEffects {
+        let mut e = PathEffects {
+            area_lights: scene.area_lights().is_some(),
+            ..PathEffects::default()
+        };
+        for m in scene.materials() {
+            let flags = SurfaceBsdf::new(m, m.colour).flags();
+            e.glossy |= flags.contains(BsdfFlags::GLOSSY);
+            e.refraction |= flags.contains(BsdfFlags::TRANSMISSION);
+            e.metal |= m.metal > 0.0;
+        }
+        e
+    }
+
+    /// Whether the scene needs the physically based path at all.
+    pub fn any(&self) -> bool {
+        self.area_lights || self.glossy || self.refraction || self.metal
+    }
+
+    /// The estimator `asked` resolves to for this scene.
+    pub fn estimator(&self, asked: Estimator) -> Estimator {
+        match asked {
+            Estimator::Auto if self.area_lights && self.glossy => Estimator::Mis,
+            Estimator::Auto => Estimator::Light,
+            e => e,
+        }
+    }
+}
+
+/// What a frame's physically based path ran: the scene's effects and the estimator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PathRun {
+    /// What the scene calls for.
+    pub effects: PathEffects,
+    /// The estimator used at vertices that are not specular.
+    pub estimator: Estimator,
+}
+
+impl PathRun {
+    /// The effects' names, for `render --stats`: "path", then area lights with their
+    /// estimator, glossy, metal, refraction, as the scene calls for them.
+    pub fn names(&self) -> Vec<&'static str> {
+        let e = self.effects;
+        let mut names = vec!["path"];
+        if e.area_lights {
+            names.push(match self.estimator {
+                Estimator::Bsdf => "area lights (bsdf sampling)",
+                Estimator::Light => "area lights (light sampling)",
+                _ => "area lights (mis)",
+            });
+        }
+        if e.glossy {
+            names.push("glossy");
+        }
+        if e.metal {
+            names.push("metal");
+        }
+        if e.refraction {
+            names.push("refraction");
+        }
+        names
+    }
+}
+
+/// The power heuristic with β = 2: the weight of a sample of density `a` against one of `b`.
+#[inline]
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 && (a2 + b2).is_finite() {
+        a2 / (a2 + b2)
+    } else if a.is_infinite() {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+/// What the previous vertex's BSDF sample left for MIS: where it was and with what density
+/// it chose the direction (`None`: the camera or a specular choice, whose emission counts
+/// whole).
+#[derive(Clone, Copy)]
+struct Came {
+    from: Vec3,
+    pdf: Option<f32>,
+}
+
+impl Tracer<'_> {
+    /// Whether this frame shades by [`Tracer::path`]: a colour frame with path-traced light
+    /// of a scene that calls for the physically based path.
+    pub(super) fn physical(&self) -> bool {
+        self.path_effects.any()
+            && self.settings.mode == Mode::Colour
+            && matches!(self.settings.effects.indirect, Indirect::PathTraced { .. })
+    }
+
+    /// What the physically based path runs in this frame (`None`: the seed's shading).
+    pub fn path_run(&self) -> Option<PathRun> {
+        self.physical().then_some(PathRun {
+            effects: self.path_effects,
+            estimator: self.estimator,
+        })
+    }
+
+    /// What an emitter shows along `ray` (its front face only; zero for the rest).
+    #[inline]
+    pub(super) fn emitted(tri: &Triangle, material: &Material, ray: &Ray) -> Vec3 {
+        if material.emits() && ray.dir.dot(tri.front()) < 0.0 {
+            material.emission
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// One path from the primary `hit` of `ray`: the colour it brings back.
+    pub(super) fn path(
+        &self,
+        ray: &Ray,
+        hit: &Hit,
+        rng: &mut impl SampleSource,
+        n: &mut RayCounts,
+    ) -> Vec3 {
+        let bounces = match self.settings.effects.indirect {
+            Indirect::PathTraced { bounces } => bounces,
+            _ => 0,
+        };
+        let scene = self.scene;
+        let tris = scene.triangles();
+        let mis = self.estimator;
+        let mut colour = Vec3::ZERO;
+        let mut beta = Vec3::ONE;
+        let (mut ray, mut hit) = (*ray, *hit);
+        let mut came = Came {
+            from: ray.origin,
+            pdf: None,
+        };
+        for vertex in 0..=bounces + 1 {
+            let tri = &tris[hit.triangle as usize];
+            let material = &scene.materials()[tri.material as usize];
+            let at = surface_of(tri, &hit, &ray);
+            let p = Vec3::from_array(at.p);
+            let e = Tracer::emitted(tri, material, &ray);
+            if e != Vec3::ZERO {
+                let w = match (came.pdf, mis) {
+                    (None, _) | (Some(_), Estimator::Bsdf) => 1.0,
+                    (Some(_), Estimator::Light) => 0.0,
+                    (Some(pb), _) => {
+                        let area = scene
+                            .area_lights()
+                            .map_or(0.0, |a| a.pdf_area(tris, hit.triangle));
+                        let pl =
+                            area_to_solid_angle(area, came.from, p, tri.front()).unwrap_or(0.0);
+                        power_heuristic(pb, pl)
+                    }
+                };
+                colour += beta * e * w;
+            }
+            if vertex > bounces {
+                break;
+            }
+            // Glass has air on the front side (local z > 0).
+            let frame = ShadingFrame::from_normal(tri.front());
+            let wo = frame.to_local(-ray.dir.normalize());
+            let bsdf = SurfaceBsdf::new(material, scene.base_colour(hit.triangle, hit.b));
+            let smooth_only = !bsdf
+                .flags()
+                .intersects(BsdfFlags::DIFFUSE | BsdfFlags::GLOSSY);
+            let u_light = (rng.next_1d(), rng.next_2d());
+            let u_bsdf = (rng.next_1d(), rng.next_2d());
+            if !smooth_only {
+                // Point lights: exact, as the seed's (π·f times its irradiance term).
+                for light in self.lights {
+                    if light.power == Vec3::ZERO {
+                        continue;
+                    }
+                    let inc = point_light(Scalar, light, self.min_r2, &at, true);
+                    if inc.lit == 0 {
+                        continue;
+                    }
+                    let wi = (light.position - p).normalize();
+                    let f = bsdf.f(wo, frame.to_local(wi));
+                    if f == Vec3::ZERO {
+                        continue;
+                    }
+                    if inc.traced != 0 {
+                        n.shadow += 1;
+                        let shadow =
+                            Ray::new(Vec3::from_array(inc.origin), Vec3::from_array(inc.dir));
+                        if scene.occluded(&shadow, 1.0 - SHADOW_EPSILON) {
+                            continue;
+                        }
+                    }
+                    colour += beta * f * Vec3::from_array(inc.term) * PI;
+                }
+                if mis != Estimator::Bsdf
+                    && let Some(lights) = scene.area_lights()
+                    && let Some(AreaIncident {
+                        wi,
+                        pdf,
+                        emission,
+                        shadow,
+                    }) = area_light(scene, lights, &at, u_light.0, Vec2::from(u_light.1))
+                {
+                    let wl = frame.to_local(wi);
+                    let f = bsdf.f(wo, wl);
+                    if f != Vec3::ZERO {
+                        n.shadow += 1;
+                        if !scene.occluded(&shadow, 1.0 - SHADOW_EPSILON) {
+                            let w = if mis == Estimator::Mis {
+                                power_heuristic(pdf, bsdf.pdf(wo, wl))
+                            } else {
+                                1.0
+                            };
+                            colour += beta * f * emission * (wl.z.abs() * w / pdf);
+                        }
+                    }
+                }
+            }
+            // Go on along a direction the BSDF picks.
+            let Some(s) = bsdf.sample_f(wo, u_bsdf.0, Vec2::from(u_bsdf.1)) else {
+                break;
+            };
+            let mut weight = s.weight();
+            if vertex >= ROULETTE_START {
+                let q = weight.max_element().clamp(MIN_SURVIVAL, 1.0);
+                if q < 1.0 && rng.next_1d() >= q {
+                    break;
+                }
+                weight /= q;
+            }
+            beta *= weight;
+            if !(beta.max_element() > 0.0) || !beta.is_finite() {
+                break;
+            }
+            let wi = frame.to_world(s.wi).normalize();
+            let origin = Vec3::from_array(offset_origin(Scalar, &at, wi.to_array()));
+            ray = Ray::new(origin, wi);
+            if s.flags.is_specular() {
+                n.reflection += 1;
+            } else {
+                n.bounce += 1;
+            }
+            came = Came {
+                from: p,
+                pdf: (!s.flags.is_specular()).then_some(s.pdf),
+            };
+            match scene.intersect(&ray, f32::INFINITY) {
+                Some(h) => hit = h,
+                None => break,
+            }
+        }
+        debug_assert!(colour.is_finite(), "non-finite colour {colour}");
+        if colour.is_finite() {
+            colour
+        } else {
+            Vec3::ZERO
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_power_heuristic_weighs_two_samplers_to_one() {
+        for (a, b) in [(1.0, 1.0), (0.3, 7.0), (0.0, 2.0), (5.0, 0.0)] {
+            let s = power_heuristic(a, b) + power_heuristic(b, a);
+            assert!((s - 1.0).abs() < 1e-6, "{a} {b}");
+        }
+        assert_eq!(power_heuristic(0.0, 0.0), 0.0);
+        assert_eq!(power_heuristic(f32::INFINITY, 1.0), 1.0);
+    }
+}
