@@ -54,14 +54,23 @@ def write_pfm(path, img):
         f.write(np.ascontiguousarray(img[::-1], dtype="<f4").tobytes())
 
 
+CLAMP = False
+
+
+def shown(a):
+    """The image as compared: clamped to 0..1 (as a screen shows it) with --clamp."""
+    return np.clip(a, 0.0, 1.0) if CLAMP else a
+
+
 def rmse(a, b):
+    a, b = shown(a), shown(b)
     return float(np.sqrt(np.mean((a - b) ** 2)))
 
 
 def block_rmse(a, b, block=10):
     """RMSE of block x block means (edge blocks smaller), as raytty's bench::metrics."""
     h, w, _ = a.shape
-    d = a - b
+    d = shown(a) - shown(b)
     sq, n = 0.0, 0
     for y in range(0, h, block):
         for x in range(0, w, block):
@@ -95,23 +104,49 @@ def mitsuba_scene(mi, spec, export_dir, width, height, spp, max_depth):
         },
     }
     for i, m in enumerate(spec["materials"]):
-        diffuse = {"type": "diffuse", "reflectance": {"type": "rgb", "value": m["colour"]}}
+        colour = {"type": "rgb", "value": m["colour"]}
+        # raytty's layers, bottom up: a diffuse base, glass over it (transmission), metal over
+        # that, the seed's mirror on top; each takes its fraction of what is above it leaves.
+        bsdf = {"type": "diffuse", "reflectance": colour}
+        # Below GGX alpha 1e-3 raytty treats a surface as smooth (material::ggx::SMOOTH_ALPHA).
+        alpha = m.get("roughness", 0.0) ** 2
+        smooth = alpha < 1e-3
+        if m.get("transmission", 0.0) > 0:
+            glass = {"type": "dielectric" if smooth else "roughdielectric", "int_ior": m["ior"],
+                     "ext_ior": 1.0, "specular_transmittance": colour}
+            if not smooth:
+                glass.update({"distribution": "ggx", "alpha": alpha})
+            bsdf = glass if m["transmission"] >= 1 else {
+                "type": "blendbsdf", "weight": m["transmission"], "a": bsdf, "b": glass}
+        if m.get("metal", 0.0) > 0:
+            # F = the colour at every angle ('none' is F = 1, times specular_reflectance);
+            # raytty's Schlick term rises toward 1 at grazing angles only.
+            metal = {"type": "conductor" if smooth else "roughconductor", "material": "none",
+                     "specular_reflectance": colour}
+            if not smooth:
+                metal.update({"distribution": "ggx", "alpha": alpha})
+            bsdf = metal if m["metal"] >= 1 else {
+                "type": "blendbsdf", "weight": m["metal"], "a": bsdf, "b": metal}
         if m["mirror"] > 0:
-            # raytty: (1 - mirror)*diffuse + mirror*perfect reflection.
+            # raytty: (1 - mirror)*the rest + mirror*perfect reflection.
             bsdf = {
                 "type": "blendbsdf",
                 "weight": m["mirror"],
-                "a": diffuse,
+                "a": bsdf,
                 "b": {"type": "conductor", "material": "none"},
             }
-        else:
-            bsdf = diffuse
-        scene[f"shape{i}"] = {
+        shape = {
             "type": "obj",
             "filename": os.path.join(export_dir, m["obj"]),
             "face_normals": True,
-            "bsdf": {"type": "twosided", "bsdf": bsdf},
+            # Glass has two sides of its own; the rest shade both sides alike.
+            "bsdf": bsdf if m.get("transmission", 0.0) > 0 else {"type": "twosided", "bsdf": bsdf},
         }
+        if max(m.get("emission", [0, 0, 0])) > 0:
+            # raytty's emission is what the camera sees, pi times radiance.
+            shape["emitter"] = {"type": "area", "radiance": {
+                "type": "rgb", "value": [e / math.pi for e in m["emission"]]}}
+        scene[f"shape{i}"] = shape
     for i, light in enumerate(spec["lights"]):
         scene[f"light{i}"] = {
             "type": "point",
@@ -150,7 +185,12 @@ def main():
     ap.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (llvm_ad_rgb, ...)")
     ap.add_argument("--max-depth", type=int, default=18)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--clamp", action="store_true",
+                    help="compare images clamped to 0..1, as shown (scenes whose lights are "
+                         "in view)")
     args = ap.parse_args()
+    global CLAMP
+    CLAMP = args.clamp
 
     import drjit as dr
     import mitsuba as mi

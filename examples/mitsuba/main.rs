@@ -41,8 +41,8 @@ fn main() {
             count += 1;
         }
         for k in 0..count {
-            // Winding kept: raytty's normal is cross(v2 − v0, v1 − v0); the shading is
-            // two-sided on both sides, so only the triangles matter.
+            // Winding kept: an OBJ face's normal is the counter-clockwise one,
+            // `Triangle::front`, the side raytty's emitters emit on and its glass has air on.
             writeln!(obj, "f {} {} {}", 3 * k + 1, 3 * k + 2, 3 * k + 3).unwrap();
         }
         if count == 0 {
@@ -50,14 +50,26 @@ fn main() {
         }
         let file = format!("material{m}.obj");
         std::fs::write(out.join(&file), obj).unwrap();
-        let c = mat.colour;
+        let (c, e) = (mat.colour, mat.emission);
         if !materials.is_empty() {
             materials.push_str(",\n");
         }
         write!(
             materials,
-            "    {{\"obj\": \"{file}\", \"colour\": [{}, {}, {}], \"mirror\": {}, \"triangles\": {count}}}",
-            c.x, c.y, c.z, mat.mirror
+            "    {{\"obj\": \"{file}\", \"colour\": [{}, {}, {}], \"mirror\": {}, \"metal\": {}, \
+             \"roughness\": {}, \"transmission\": {}, \"ior\": {}, \"emission\": [{}, {}, {}], \
+             \"triangles\": {count}}}",
+            c.x,
+            c.y,
+            c.z,
+            mat.mirror,
+            mat.metal,
+            mat.roughness,
+            mat.transmission,
+            mat.ior,
+            e.x,
+            e.y,
+            e.z
         )
         .unwrap();
     }
