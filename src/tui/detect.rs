@@ -11,8 +11,8 @@
 //! - the cell size in pixels: `CSI 16 t` (answered `CSI 6;h;w t`), else the text area
 //!   `CSI 14 t` (`CSI 4;h;w t`) over the grid; the caller prefers `TIOCGWINSZ`'s pixel fields
 //!   when the terminal fills them.
-//! - the largest sixel image: XTSMGRAPHICS (`CSI ? 2;1 S`, answered `CSI ? 2;0;w;h S`): xterm
-//!   draws nothing of a larger one (its default limit is 1000×1000).
+//! - the largest sixel image: XTSMGRAPHICS (`CSI ? 2;1 S`, answered `CSI ? 2;0;w;h S`), else
+//!   [`SIXEL_MAX_UNTOLD`]: xterm draws nothing of a larger one.
 //!
 //! DA1 goes last: every terminal answers it, and in order, so its answer means no other
 //! answer is still on its way. Inside tmux the kitty query goes to the outer terminal through
@@ -279,6 +279,12 @@ pub fn choose(choice: Choice, answers: &Answers, cell_known: bool) -> Option<Pro
         Choice::Auto => None,
     }
 }
+
+/// The largest sixel image assumed when the terminal does not answer XTSMGRAPHICS: xterm's
+/// default `maxGraphicSize`, above which it draws nothing (xterm 379 as Debian builds it
+/// answered neither XTSMGRAPHICS nor `CSI 16 t` under `-ti vt340`; it tells its pixels through
+/// `TIOCGWINSZ`).
+pub const SIXEL_MAX_UNTOLD: (u32, u32) = (1000, 1000);
 
 /// The cell size assumed when the terminal tells none: 10×20 pixels, a common monospace cell
 /// at 12–13 points. Only a forced protocol uses it.

@@ -233,7 +233,7 @@ fn detect(input: RawFd, choice: Choice, size: (u16, u16), tmux: bool) -> Found {
         protocol: detect::choose(choice, &answers, cell.is_some()),
         cell: cell.unwrap_or(detect::FALLBACK_CELL),
         keys: answers.take_other(),
-        sixel_max: answers.sixel_max,
+        sixel_max: answers.sixel_max.or(Some(detect::SIXEL_MAX_UNTOLD)),
     }
 }
 
