@@ -303,7 +303,22 @@ impl Tracer<'_> {
             };
             let mut weight = s.weight();
             if vertex >= ROULETTE_START {
-                let q = weight.max_element().clamp(MIN_SURVIVAL, 1.0);
+                // The survival chance follows what the surface keeps of the light: a
+                // refraction's 1/η'² is radiance changing units across the interface (undone
+                // on the way out), not light lost, so it is taken out: paths inside glass are
+                // not cut short (the glass scene, 160x100 at 256 spp: RMSE 0.0245 -> 0.0165
+                // against Mitsuba's 4096-spp frame, for 15 % more time).
+                let kept = if s.flags.contains(BsdfFlags::TRANSMISSION) && wo.z * s.wi.z < 0.0 {
+                    let etap = if wo.z > 0.0 {
+                        material.ior
+                    } else {
+                        1.0 / material.ior
+                    };
+                    weight * (etap * etap)
+                } else {
+                    weight
+                };
+                let q = kept.max_element().clamp(MIN_SURVIVAL, 1.0);
                 if q < 1.0 && rng.next_1d() >= q {
                     break;
                 }
