@@ -673,3 +673,57 @@ fn a_half_cpu_quota_gives_one_thread() {
     let err = String::from_utf8(out.stderr).unwrap();
     assert!(err.contains("\"threads\":1"), "{err}");
 }
+
+/// `--stats` names the physically based effects a frame ran; the hidden `--estimator` picks
+/// how they gather light, and a wrong name is a usage error.
+#[test]
+fn stats_name_the_effects_and_the_estimator() {
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "--scene",
+            "plates",
+            "--stage",
+            "gi",
+            "--pixels",
+            "8x6",
+            "--format",
+            "pfm",
+            "-o",
+            "/dev/null",
+            "--stats",
+        ];
+        args.extend_from_slice(extra);
+        raytty(&args)
+    };
+    let out = run(&[]);
+    assert!(out.status.success());
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("effects: path, area lights (mis), glossy, metal"),
+        "{err}"
+    );
+    let err = String::from_utf8(run(&["--estimator", "bsdf"]).stderr).unwrap();
+    assert!(err.contains("area lights (bsdf sampling)"), "{err}");
+    let out = run(&["--estimator", "mmis"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8(out.stderr)
+            .unwrap()
+            .contains("expected auto, light, bsdf or mis")
+    );
+    // The seed's scenes name none.
+    let out = raytty(&[
+        "render",
+        "--stage",
+        "gi",
+        "--pixels",
+        "8x6",
+        "--format",
+        "pfm",
+        "-o",
+        "/dev/null",
+        "--stats",
+    ]);
+    assert!(!String::from_utf8(out.stderr).unwrap().contains("effects"));
+}

@@ -7,6 +7,7 @@ use glam::Vec3;
 use raytty::frame::CellMode;
 use raytty::sampler::Sampler;
 use raytty::scene::MAX_COORDINATE;
+use raytty::shading::Estimator;
 use raytty::simd::Isa;
 use raytty::{ColorMode, Stage};
 
@@ -330,6 +331,17 @@ pub(super) struct RenderArgs {
     /// path gives the same frame; this is for checking that.
     #[arg(long, value_name = "PATH", value_parser = parse_simd, hide = true)]
     pub(super) simd: Option<Isa>,
+    /// How physically based scenes gather light at surfaces that are not specular: auto (what
+    /// the scene calls for), light, bsdf or mis. For measuring the estimators.
+    #[arg(long, value_name = "E", value_parser = parse_estimator, hide = true)]
+    pub(super) estimator: Option<Estimator>,
+}
+
+pub(super) fn parse_estimator(s: &str) -> Result<Estimator, String> {
+    Estimator::ALL
+        .into_iter()
+        .find(|e| e.name() == s)
+        .ok_or_else(|| format!("'{s}' is not an estimator: expected auto, light, bsdf or mis"))
 }
 
 /// How `render --stats` prints the frame's cost.

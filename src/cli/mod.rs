@@ -261,6 +261,7 @@ fn run_default(
             output: None,
             stats: None,
             simd: None,
+            estimator: None,
         },
         scene,
         view,

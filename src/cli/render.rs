@@ -132,6 +132,9 @@ pub(super) fn run_render(
     if let Some(s) = args.sampler {
         settings.effects.sampler = s;
     }
+    if let Some(e) = args.estimator {
+        settings.estimator = e;
+    }
     if args.output.is_none() && stdout_was_closed() {
         return Err(anyhow::anyhow!(
             "stdout is closed: there is nowhere to write the frame (redirect it, or give -o FILE)"
