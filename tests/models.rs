@@ -261,3 +261,50 @@ fn bad_files_and_views_are_refused() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
 }
+
+/// `lamp.gltf` and its twin `lamp.obj` + `lamp.mtl` (written by `make_lamp_twins.py`): a floor,
+/// a red wall, a gold metal block and a ceiling panel that emits. The files' materials map onto
+/// the same scene materials (metal, roughness, emission), the emitting panel stands for the
+/// light (no default rig), light is path traced, and the two render the same to the bit.
+#[test]
+fn a_gltf_lamp_and_its_obj_twin_render_alike() {
+    let (gltf, obj) = (load("lamp.gltf").scene, load("lamp.obj").scene);
+    assert_eq!(triangles(&gltf), triangles(&obj));
+    for s in [&gltf, &obj] {
+        let m = s.materials();
+        let gold = m.iter().find(|m| m.metal > 0.0).expect("a metal material");
+        assert_eq!((gold.metal, gold.roughness), (1.0, 0.3));
+        assert_eq!(gold.colour, Vec3::new(0.9, 0.7, 0.4));
+        let panel = m
+            .iter()
+            .find(|m| m.emission != Vec3::ZERO)
+            .expect("an emitter");
+        assert_eq!(panel.emission, Vec3::new(5.0, 4.5, 4.0));
+        assert!(
+            m.iter()
+                .filter(|m| m.emission == Vec3::ZERO && m.metal == 0.0)
+                .all(|m| m.roughness == 0.0 && m.transmission == 0.0)
+        );
+        assert!(s.lights().is_empty() && !s.lights_are_default());
+        assert!(s.area_lights().is_some());
+    }
+    let options = raytty::Options {
+        width: 48,
+        height: 36,
+        ..Default::default()
+    };
+    let (a, b) = (gltf.render(&options), obj.render(&options));
+    assert_eq!(a.image.pixels, b.image.pixels);
+    assert!(
+        a.stats.rays.shadow > 0 && a.stats.rays.bounce > 0,
+        "{:?}",
+        a.stats.rays
+    );
+    let lit = a
+        .image
+        .pixels
+        .iter()
+        .filter(|p| p.max_element() > 0.005)
+        .count();
+    assert!(lit > a.image.pixels.len() / 8, "only {lit} pixels lit");
+}

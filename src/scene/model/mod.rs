@@ -1,13 +1,13 @@
 //! Models made by other tools: glTF 2.0 (`.gltf`, `.glb`), OBJ with MTL, PLY and STL. Each
 //! format's reader fills one [`Model`] (positions, optional normals, UVs and vertex colours,
 //! triangles with their materials, the file's cameras and lights); [`Model::into_scene`] turns
-//! it into a [`Scene`] with a camera that finds the model ([`view`]) and, when the file has no
-//! light, the default rig.
+//! it into a [`Scene`] with a camera that finds the model ([`view`]) and, when nothing in the
+//! file gives light (no light, no emitting material), the default rig.
 //!
 //! Materials keep every physically based value the file gives (metallic, roughness, emission,
-//! index of refraction, transmission, opacity, the base colour texture's name) for the
-//! physically based materials to come; today's [`Material`] takes the base colour only
-//! (times the triangle's average vertex colour).
+//! index of refraction, transmission, opacity, the base colour texture's name);
+//! [`scene_material`] maps them onto the scene's [`Material`] (metal, glass, emission; the base
+//! colour times the triangle's average vertex colour). Textures are not sampled yet.
 //!
 //! Every mistake is a [`SceneFileError`] naming the file and where: a line and column in text,
 //! a JSON path in glTF, a byte offset in binary data.
@@ -24,8 +24,8 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 
-use crate::scene::file::SceneFileError;
-use crate::scene::{Effects, MAX_COORDINATE, Material, PointLight, Scene, SceneBuilder};
+use crate::scene::file::{MAX_EMISSION, SceneFileError};
+use crate::scene::{Effects, MAX_COORDINATE, MAX_IOR, Material, PointLight, Scene, SceneBuilder};
 
 pub use view::{View, ViewError};
 
@@ -235,7 +235,27 @@ impl Model {
                 self.lights.len()
             ));
         }
-        let default_lights = lights.is_empty();
+        // The default rig only where nothing in the file gives light: no punctual light and
+        // no emitting material.
+        let used: Vec<Material> = self
+            .materials
+            .iter()
+            .map(|m| scene_material(m, Vec3::ONE))
+            .collect();
+        let emits = used.iter().any(|m| m.emission != Vec3::ZERO);
+        let default_lights = lights.is_empty() && !emits;
+        // Light from surfaces, metal and glass show only where light is path traced (as in the
+        // built-in scenes that have them: 16 bounces); other models keep the seed's effects.
+        let traced =
+            |m: &Material| m.emission != Vec3::ZERO || m.metal > 0.0 || m.transmission > 0.0;
+        let effects = if used.iter().any(traced) {
+            Effects {
+                indirect: crate::scene::Indirect::PathTraced { bounces: 16 },
+                ..Effects::default()
+            }
+        } else {
+            Effects::default()
+        };
         if default_lights {
             lights = view::default_rig(&camera, bounds);
         }
@@ -251,7 +271,7 @@ impl Model {
         drop(self.positions);
         drop(self.triangles);
         let scene = b
-            .build(name, camera, Effects::default())
+            .build(name, camera, effects)
             .map_err(|e| SceneFileError::whole_file(file, e.to_string()))?;
         let dropped = triangles - scene.triangles().len();
         if scene.triangles().is_empty() {
@@ -279,16 +299,16 @@ impl Model {
         (lo, hi)
     }
 
-    /// Today's materials for the triangles, one index per triangle (or one for all): the
-    /// base colour, times the triangle's average vertex colour when the model has them
-    /// (rounded to 8 bits a channel so that a scan's colours share materials).
+    /// The scene's materials for the triangles, one index per triangle (or one for all): each
+    /// file material as [`scene_material`] maps it, its base colour times the triangle's
+    /// average vertex colour when the model has them (rounded to 8 bits a channel so that a
+    /// scan's colours share materials).
     fn scene_materials(&self, b: &mut SceneBuilder) -> Vec<u32> {
-        let colour = |m: &ModelMaterial| m.base_colour.clamp(Vec3::ZERO, Vec3::ONE);
         if self.colours.is_empty() {
             let ids: Vec<u32> = self
                 .materials
                 .iter()
-                .map(|m| b.material(Material::diffuse(colour(m))))
+                .map(|m| b.material(scene_material(m, Vec3::ONE)))
                 .collect();
             if self.triangle_materials.is_empty() {
                 return vec![ids[0]];
@@ -312,11 +332,51 @@ impl Model {
                     .map(|x| x as u8);
                 *ids.entry((m as u32, q)).or_insert_with(|| {
                     let c = Vec3::from(q.map(|x| x as f32 / 255.0));
-                    b.material(Material::diffuse(colour(&self.materials[m]) * c))
+                    b.material(scene_material(&self.materials[m], c))
                 })
             })
             .collect()
     }
+}
+
+/// A file's material as a scene's, its base colour times `tint`: glTF's metallic-roughness
+/// model (and MTL's `Pm`, `Pr`, `Ni`, `Ke` and glass `illum`, which the reader maps onto it)
+/// as raytty's materials take it: the metallic fraction a GGX conductor of F0 = base colour,
+/// the transmission fraction glass of the file's IOR, both of the file's roughness; the rest
+/// Lambertian (glTF's dielectric specular coat over it is left out: raytty has no layered
+/// material yet); emission as the camera sees it. Values are clamped into the ranges a scene
+/// allows. A plain dielectric is exactly [`Material::diffuse`], so such models render as
+/// before. Opacity (glTF's alpha, MTL's `d` without a glass `illum`) is not simulated.
+fn scene_material(m: &ModelMaterial, tint: Vec3) -> Material {
+    let unit = |v: f32| {
+        if v.is_finite() {
+            v.clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    };
+    let colour = m.base_colour.clamp(Vec3::ZERO, Vec3::ONE).map(unit) * tint;
+    let mut out = Material::diffuse(colour);
+    let e = m.emission.map(|c| {
+        if c.is_finite() {
+            c.clamp(0.0, MAX_EMISSION as f32)
+        } else {
+            0.0
+        }
+    });
+    out.emission = e;
+    let (metal, transmission) = (unit(m.metallic), unit(m.transmission));
+    if metal > 0.0 || transmission > 0.0 {
+        out.metal = metal;
+        out.transmission = transmission;
+        out.roughness = unit(m.roughness);
+        out.ior = if m.ior.is_finite() {
+            m.ior.clamp(1.0, MAX_IOR)
+        } else {
+            1.5
+        };
+    }
+    out
 }
 
 /// Reads the model file at `path` (its format by extension) with the files it names, and
