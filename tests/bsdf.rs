@@ -5,6 +5,7 @@
 //! (roughness 0 or 1, IOR 1, grazing directions) gives NaN or infinity.
 
 use glam::{Vec2, Vec3};
+use raytty::material::SurfaceBsdf;
 use raytty::material::{
     Bsdf, BsdfFlags, Conductor, Dielectric, Lambertian, Mirror, RoughDielectric, ShadingFrame,
     fresnel_dielectric,
@@ -27,7 +28,38 @@ fn uniform_sphere(rng: &mut Rng) -> Vec3 {
     )
 }
 
-fn draw(bsdf: &Bsdf, wo: Vec3, rng: &mut Rng) -> Option<raytty::material::BsdfSample> {
+/// What the χ² test asks of a sampler: one BSDF, or a material's weighted lobes.
+trait Sampled {
+    fn sample_f(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<raytty::material::BsdfSample>;
+    fn f(&self, wo: Vec3, wi: Vec3) -> Vec3;
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+}
+
+impl Sampled for Bsdf {
+    fn sample_f(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<raytty::material::BsdfSample> {
+        Bsdf::sample_f(self, wo, uc, u)
+    }
+    fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        Bsdf::f(self, wo, wi)
+    }
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        Bsdf::pdf(self, wo, wi)
+    }
+}
+
+impl Sampled for SurfaceBsdf {
+    fn sample_f(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<raytty::material::BsdfSample> {
+        SurfaceBsdf::sample_f(self, wo, uc, u)
+    }
+    fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        SurfaceBsdf::f(self, wo, wi)
+    }
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        SurfaceBsdf::pdf(self, wo, wi)
+    }
+}
+
+fn draw(bsdf: &impl Sampled, wo: Vec3, rng: &mut Rng) -> Option<raytty::material::BsdfSample> {
     let uc = rng.next_f32();
     let u = Vec2::new(rng.next_f32(), rng.next_f32());
     bsdf.sample_f(wo, uc, u)
@@ -96,7 +128,7 @@ fn bin_of(w: Vec3) -> usize {
 
 /// Each bin's probability by the stated pdf, integrated by the midpoint rule on a `k`×`k`
 /// grid per bin (in cos θ and φ, so each cell has the same solid angle).
-fn expected(bsdf: &Bsdf, wo: Vec3, k: usize) -> Vec<f64> {
+fn expected(bsdf: &impl Sampled, wo: Vec3, k: usize) -> Vec<f64> {
     let cell = 4.0 * std::f64::consts::PI / (Z_BINS * PHI_BINS * k * k) as f64;
     let mut out = vec![0.0; Z_BINS * PHI_BINS];
     for (b, e) in out.iter_mut().enumerate() {
@@ -145,7 +177,7 @@ fn chi2_z(counts: &[u64], expected: &[f64], n: u64) -> (f64, usize) {
 }
 
 /// Draws `n` directions and bins them; also checks each sample against `f` and `pdf`.
-fn histogram(bsdf: &Bsdf, wo: Vec3, n: u64, seed: u64) -> Vec<u64> {
+fn histogram(bsdf: &impl Sampled, wo: Vec3, n: u64, seed: u64) -> Vec<u64> {
     let mut rng = Rng::seeded(seed);
     let mut counts = vec![0u64; Z_BINS * PHI_BINS];
     for _ in 0..n {
@@ -186,6 +218,33 @@ fn sampling_matches_the_pdf_by_chi_square() {
             );
             assert!(z < 4.5, "{name}, wo {wo}: χ² z = {z} over {dof} bins");
         }
+    }
+}
+
+/// A material of several glossy and diffuse parts (a scene's `Material` as the path tracer
+/// sees it) samples its mixture with the density its `pdf` states: the lobe picked by weight,
+/// the value and pdf those of the whole sum.
+#[test]
+fn a_materials_mixture_samples_its_pdf_by_chi_square() {
+    let n = 200_000;
+    let m = raytty::Material {
+        metal: 0.3,
+        transmission: 0.5,
+        roughness: 0.4,
+        ..raytty::Material::diffuse(Vec3::new(0.8, 0.6, 0.3))
+    };
+    let bsdf = SurfaceBsdf::new(&m, m.colour);
+    for (i, wo) in outgoing().into_iter().enumerate() {
+        let counts = histogram(&bsdf, wo, n, 300 + i as u64);
+        let e = expected(&bsdf, wo, 12);
+        let (z, dof) = chi2_z(&counts, &e, n);
+        let drawn: u64 = counts.iter().sum();
+        let total: f64 = e.iter().sum();
+        assert!(
+            (total - drawn as f64 / n as f64).abs() < 0.01,
+            "wo {wo}: pdf integrates to {total}, {drawn} of {n} drawn"
+        );
+        assert!(z < 4.5, "wo {wo}: χ² z = {z} over {dof} bins");
     }
 }
 
