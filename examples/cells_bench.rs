@@ -2,7 +2,9 @@
 //! cells (default 100×50) at 16 samples a pixel, what the terminal shows (decoded: each glyph's
 //! ink and background painted on 12×24-pixel cells; a pixel image scaled up by repeating its
 //! pixels) against the same frame rendered at 12×24 pixels a cell, as PSNR; the bytes of a
-//! whole frame (`encode_text`, and the app's first diffed frame), and the time to encode it
+//! whole frame (`encode_text`, and the app's first diffed frame), of the app's diff after a
+//! light move (the light 0.1 forward, one W) and after a turn (5°, one →) — for the pixel
+//! protocols, the whole image again, as the app sends it — and the time to encode it
 //! (median CPU time of the thread; the encoders run on one thread). With chafa installed, the same frame
 //! through chafa (`-w 9`, given the 12×24-pixel render) for comparison.
 //!
@@ -45,16 +47,25 @@ fn main() {
     let scene = cornell_box();
     let mut settings = raytty::Stage::Indirect.settings(scene.effects());
     settings.effects.samples = SAMPLES;
-    let frame = |w: u32, h: u32| {
+    let camera = scene.camera();
+    let mut turned = camera;
+    turned.yaw += 5f32.to_radians();
+    let mut moved = scene.lights().to_vec();
+    moved[0].position += camera.to_world(Vec3::new(0.0, 0.0, 0.1));
+    // The frame as it starts, after a light move, after a turn.
+    let render = |w: u32, h: u32, view: usize| {
         scene
             .render(&Options {
                 width: w,
                 height: h,
                 settings: Some(settings),
+                camera: Some(if view == 2 { turned } else { camera }),
+                lights: (view == 1).then_some(&moved[..]),
                 ..Options::default()
             })
             .image
     };
+    let frame = |w: u32, h: u32| render(w, h, 0);
     let (full_w, full_h) = (cols * CELL.0, rows * CELL.1);
     let reference = frame(full_w, full_h);
     let runs = Runs {
@@ -66,7 +77,7 @@ fn main() {
         "seed frame, {cols}x{rows} cells, {SAMPLES} spp; PSNR against {full_w}x{full_h}; encode: median CPU ms"
     );
     println!(
-        "| mode | PSNR dB | text bytes | first diff bytes | encode ms |\n|---|---:|---:|---:|---:|"
+        "| mode | PSNR dB | text bytes | first diff bytes | light move bytes | turn bytes | encode ms |\n|---|---:|---:|---:|---:|---:|---:|"
     );
     for mode in CellMode::ALL {
         let (sw, sh) = mode.render_pixels();
@@ -77,6 +88,14 @@ fn main() {
         let text = encode_text(&grid).len();
         let mut diff = Vec::new();
         encode_diff(None, &grid, 0, &mut diff);
+        let after = |view: usize| {
+            let next = render(cols * sw, rows * sh, view);
+            let next = CellGrid::from_image_in(&next, ColorMode::TrueColor, mode);
+            let mut out = Vec::new();
+            encode_diff(Some(&grid), &next, 0, &mut out);
+            out.len()
+        };
+        let (light, turn) = (after(1), after(2));
         let t = measure(
             runs,
             || {
@@ -88,19 +107,31 @@ fn main() {
             || {},
         );
         println!(
-            "| {} | {psnr:.2} | {text} | {} | {:.2} |",
+            "| {} | {psnr:.2} | {text} | {} | {light} | {turn} | {:.2} |",
             mode.name(),
             diff.len(),
             ms(t.median())
         );
     }
-    for (name, (pw, ph)) in [("kitty", (4, 8)), ("kitty", (12, 24)), ("sixel", (4, 8))] {
+    for (name, (pw, ph)) in [
+        ("kitty", (4, 8)),
+        ("kitty", (12, 24)),
+        ("sixel", (4, 8)),
+        ("sixel", (12, 24)),
+    ] {
         let (w, h) = (cols * pw, rows * ph);
-        let rgb = frame(w, h).to_rgb8();
-        let encode = |out: &mut Vec<u8>| match name {
-            "kitty" => encode_kitty(&rgb, w, h, out),
-            _ => encode_sixel(&rgb, w, h, out),
+        let encode_rgb = |rgb: &[[u8; 3]], out: &mut Vec<u8>| match name {
+            "kitty" => encode_kitty(rgb, w, h, out),
+            _ => encode_sixel(rgb, w, h, out),
         };
+        let again = |view: usize| {
+            let mut out = Vec::new();
+            encode_rgb(&render(w, h, view).to_rgb8(), &mut out);
+            out.len()
+        };
+        let (light, turn) = (again(1), again(2));
+        let rgb = frame(w, h).to_rgb8();
+        let encode = |out: &mut Vec<u8>| encode_rgb(&rgb, out);
         let mut bytes = Vec::new();
         encode(&mut bytes);
         let shown = match name {
@@ -121,7 +152,7 @@ fn main() {
             || {},
         );
         println!(
-            "| {name} {pw}x{ph} px/cell | {psnr:.2} | {} | - | {:.2} |",
+            "| {name} {pw}x{ph} px/cell | {psnr:.2} | {} | - | {light} | {turn} | {:.2} |",
             bytes.len(),
             ms(t.median())
         );
@@ -258,7 +289,7 @@ fn chafa(reference: &Image, cols: u32, rows: u32) {
         let shown = paint(&grid, CELL.0 as usize, CELL.1 as usize);
         let psnr = psnr8(&to_image(&shown, cols * CELL.0, rows * CELL.1), reference);
         println!(
-            "| chafa -w 9 {symbols} | {psnr:.2} | {} | - | {:.0} (process) |{}",
+            "| chafa -w 9 {symbols} | {psnr:.2} | {} | - | - | - | {:.0} (process) |{}",
             out.stdout.len(),
             ms(elapsed),
             if unknown > 0 {

@@ -380,6 +380,10 @@ impl Writer {
 
     /// Moves the cursor to (row, col) of the grid the shortest way it knows.
     fn move_to(&mut self, out: &mut Vec<u8>, r: usize, c: usize) {
+        // Already there (most cells of a whole frame): nothing to write, nothing to allocate.
+        if self.cursor == Some((r, c)) {
+            return;
+        }
         let mut best = format!("\x1b[{};{}H", self.top + r + 1, c + 1);
         let mut consider = |s: String| {
             if s.len() < best.len() {

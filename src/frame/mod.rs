@@ -9,8 +9,6 @@ mod diff;
 mod kitty;
 mod sixel;
 
-use std::io::Write;
-
 pub use diff::{
     DiffLimits, DiffOutcome, FULL_BLOCK, LOWER_HALF, UNLIKE, distance, encode_diff,
     encode_diff_within, pixels,
@@ -232,11 +230,35 @@ impl Pen {
     }
 }
 
+/// `38;2;r;g;b` and the like, written digit by digit: through `write!` the formatting machinery
+/// took most of a frame's encoding (200×50 octant cells, encode_text: see `cells_bench`).
 fn write_colour(out: &mut Vec<u8>, base: u8, c: Colour) {
-    let _ = match c {
-        Colour::Rgb(r, g, b) => write!(out, "{base};2;{r};{g};{b}"),
-        Colour::Indexed(i) => write!(out, "{base};5;{i}"),
-    };
+    write_u8(out, base);
+    match c {
+        Colour::Rgb(r, g, b) => {
+            out.extend_from_slice(b";2;");
+            write_u8(out, r);
+            out.push(b';');
+            write_u8(out, g);
+            out.push(b';');
+            write_u8(out, b);
+        }
+        Colour::Indexed(i) => {
+            out.extend_from_slice(b";5;");
+            write_u8(out, i);
+        }
+    }
+}
+
+/// `v` in decimal, no leading zeros.
+fn write_u8(out: &mut Vec<u8>, v: u8) {
+    if v >= 100 {
+        out.push(b'0' + v / 100);
+    }
+    if v >= 10 {
+        out.push(b'0' + v / 10 % 10);
+    }
+    out.push(b'0' + v % 10);
 }
 
 fn write_char(out: &mut Vec<u8>, ch: char) {
@@ -273,6 +295,17 @@ mod tests {
             width: w,
             height: pixels.len() as u32 / w,
             pixels,
+        }
+    }
+
+    #[test]
+    fn colours_are_written_as_format_would() {
+        for v in 0..=255u8 {
+            let mut out = Vec::new();
+            write_colour(&mut out, 38, Colour::Rgb(v, 255 - v, v / 3));
+            write_colour(&mut out, 48, Colour::Indexed(v));
+            let want = format!("38;2;{v};{};{}48;5;{v}", 255 - v, v / 3);
+            assert_eq!(String::from_utf8(out).unwrap(), want);
         }
     }
 
