@@ -326,22 +326,19 @@ fn best_split<const N: usize, const G: usize>(
     debug_assert_eq!(G * LANES, 1 << (N - 1));
     let p: [[f32; 3]; N] = px.map(|c| c.map(f32::from));
     // Sums of each subset of pixels 0-2 (a lane's) and of pixels 3..N−1 (a group's).
+    // Each subset's sum is a smaller subset's plus one pixel (the subset without its lowest
+    // bit): one add each, where testing every pixel's bit compiled to masked vector loads and
+    // stores (200×50 octant cells 2.9 -> 1.8 ms of CPU, sextants 1.4 -> 1.2: medians of five
+    // interleaved runs of `cells_bench`). Whole numbers, so exact in any order: the same cells.
+    // Pixels 0-2 vary across lanes, 3..N−1 across groups (the last is always background).
     let mut low = [[0.0f32; LANES]; 3];
     let mut high = [[0.0f32; G]; 3];
     for ch in 0..3 {
-        for (l, sum) in low[ch].iter_mut().enumerate() {
-            for (b, q) in p.iter().enumerate().take(3) {
-                if l >> b & 1 == 1 {
-                    *sum += q[ch];
-                }
-            }
+        for l in 1..LANES {
+            low[ch][l] = low[ch][l & (l - 1)] + p[l.trailing_zeros() as usize][ch];
         }
-        for (g, sum) in high[ch].iter_mut().enumerate() {
-            for (b, q) in p.iter().enumerate().skip(3).take(N - 4) {
-                if g >> (b - 3) & 1 == 1 {
-                    *sum += q[ch];
-                }
-            }
+        for g in 1..G {
+            high[ch][g] = high[ch][g & (g - 1)] + p[3 + g.trailing_zeros() as usize][ch];
         }
     }
     let total = [0, 1, 2].map(|ch| p.iter().map(|q| q[ch]).sum::<f32>());
