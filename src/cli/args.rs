@@ -15,7 +15,8 @@ use raytty::{ColorMode, Stage};
 ///
 /// With no command on a terminal, raytty runs the interactive app; when stdout is not a
 /// terminal (or TERM is dumb) it prints one frame, as `raytty render` would. Frames are truecolor half-blocks:
-/// each cell shows two pixels, so an 80×24 frame is 80×48 pixels.
+/// each cell shows two pixels, so an 80×24 frame is 80×48 pixels; in a terminal that speaks
+/// the kitty graphics protocol or sixel, the app draws real pixels (--graphics).
 #[derive(Parser, Debug)]
 #[command(name = "raytty", version, about, long_about)]
 pub struct Cli {
