@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 mod bins;
 
-use bins::{Binning, Bounds, NodeBounds, PrimRef, bin_all};
+use bins::{Binning, Bounds, Grow, NodeBounds, PrimRef, bin_all};
 
 use super::{MAX_DEPTH, Node, NodePair};
 use crate::geometry::Triangle;
@@ -90,13 +90,16 @@ pub(super) fn build(triangles: &[Triangle]) -> Built {
     let mut refs: Vec<PrimRef> = triangles
         .par_iter()
         .enumerate()
-        .map(|(i, t)| PrimRef {
-            min: t.v[0].min(t.v[1]).min(t.v[2]),
-            max: t.v[0].max(t.v[1]).max(t.v[2]),
-            id: i as u32,
+        .map(|(i, t)| {
+            PrimRef::new(
+                t.v[0].min(t.v[1]).min(t.v[2]),
+                t.v[0].max(t.v[1]).max(t.v[2]),
+                i as u32,
+            )
         })
         .collect();
-    let (mut root, below, depth) = subtree(&mut refs, 0, 1, f64::NAN);
+    let nb = NodeBounds::of(&refs);
+    let (mut root, below, depth) = subtree(&mut refs, nb, 0, 1, f64::NAN);
     debug_assert!(depth as usize <= MAX_DEPTH);
     if !root.is_leaf() {
         // The root's children are the next pair: flat index 2.
@@ -107,7 +110,7 @@ pub(super) fn build(triangles: &[Triangle]) -> Built {
     below.flatten(&mut pairs);
     Built {
         pairs,
-        order: refs.par_iter().map(|r| r.id).collect(),
+        order: refs.par_iter().map(PrimRef::id).collect(),
         depth,
     }
 }
@@ -162,29 +165,35 @@ impl Part {
     }
 }
 
-/// Builds the subtree over `refs` (whose first entry is at `first` in leaf order) at level
-/// `depth`: its root (an interior root's `offset` is set by the caller), what lies below it,
-/// and the deepest level reached. Halves of large nodes are built in parallel.
-fn subtree(refs: &mut [PrimRef], first: usize, depth: u32, root_area: f64) -> (Node, Part, u32) {
+/// Builds the subtree over `refs` (whose bounds are `nb`; whose first entry is at `first` in
+/// leaf order) at level `depth`: its root (an interior root's `offset` is set by the caller),
+/// what lies below it, and the deepest level reached. Halves of large nodes are built in
+/// parallel.
+fn subtree(
+    refs: &mut [PrimRef],
+    nb: NodeBounds,
+    first: usize,
+    depth: u32,
+    root_area: f64,
+) -> (Node, Part, u32) {
     if refs.len() < PARALLEL_NODE {
         let mut pairs = Vec::with_capacity(refs.len() / 2);
-        let (root, d) = build_node(refs, first, depth, root_area, &mut pairs);
+        let (root, d) = build_node(refs, nb, first, depth, root_area, &mut pairs);
         return (root, Part::Pairs(pairs), d);
     }
-    let nb = NodeBounds::of(refs);
     let root_area = if depth == 1 {
         nb.bounds.area()
     } else {
         root_area
     };
-    let Some(mid) = split(refs, &nb, depth, root_area) else {
+    let Some((mid, lb, rb)) = split(refs, &nb, depth, root_area) else {
         // (Only nodes of at most LEAF_MAX triangles become leaves.)
         return (leaf(&nb, first, refs.len()), Part::Pairs(Vec::new()), depth);
     };
     let (left, right) = refs.split_at_mut(mid);
     let ((l, l_below, l_depth), (r, r_below, r_depth)) = rayon::join(
-        || subtree(left, first, depth + 1, root_area),
-        || subtree(right, first + mid, depth + 1, root_area),
+        || subtree(left, lb, first, depth + 1, root_area),
+        || subtree(right, rb, first + mid, depth + 1, root_area),
     );
     let len = 1 + l_below.len() + r_below.len();
     (
@@ -214,49 +223,57 @@ fn interior(nb: &NodeBounds, offset: usize) -> Node {
     }
 }
 
-/// Builds the subtree over `refs` sequentially, appending the pairs below its root to `out`;
-/// returns the root (an interior root's `offset` is its children's index in `out`) and the
-/// deepest level reached. `root_area` is the whole tree's box's area (any value at depth 1).
+/// Builds the subtree over `refs` (whose bounds are `nb`) sequentially, appending the pairs
+/// below its root to `out`; returns the root (an interior root's `offset` is its children's
+/// index in `out`) and the deepest level reached. `root_area` is the whole tree's box's area
+/// (any value at depth 1).
 fn build_node(
     refs: &mut [PrimRef],
+    nb: NodeBounds,
     first: usize,
     depth: u32,
     root_area: f64,
     out: &mut Vec<NodePair>,
 ) -> (Node, u32) {
     let n = refs.len();
-    let nb = NodeBounds::of(refs);
     let root_area = if depth == 1 {
         nb.bounds.area()
     } else {
         root_area
     };
-    let Some(mid) = split(refs, &nb, depth, root_area) else {
+    let Some((mid, lb, rb)) = split(refs, &nb, depth, root_area) else {
         return (leaf(&nb, first, n), depth);
     };
     let at = out.len();
     out.push(NodePair([Node::UNUSED; 2]));
     let (left, right) = refs.split_at_mut(mid);
-    let (l, l_depth) = build_node(left, first, depth + 1, root_area, out);
-    let (r, r_depth) = build_node(right, first + mid, depth + 1, root_area, out);
+    let (l, l_depth) = build_node(left, lb, first, depth + 1, root_area, out);
+    let (r, r_depth) = build_node(right, rb, first + mid, depth + 1, root_area, out);
     out[at] = NodePair([l, r]);
     (interior(&nb, at), l_depth.max(r_depth))
 }
 
 /// Decides how to split the node and reorders `refs` so that the left half comes first;
-/// returns the left half's size, or `None` for a leaf.
-fn split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32, root_area: f64) -> Option<usize> {
+/// returns the left half's size and both halves' bounds, or `None` for a leaf.
+fn split(
+    refs: &mut [PrimRef],
+    nb: &NodeBounds,
+    depth: u32,
+    root_area: f64,
+) -> Option<(usize, NodeBounds, NodeBounds)> {
     let n = refs.len();
     let mid = match choose_split(refs, nb, depth, root_area) {
         Split::Leaf => return None,
         Split::Binned(binning, bin) => {
-            partition(refs, |r| binning.bin(r.centroid(binning.axis)) < bin)
+            let (mid, l, r) = partition(refs, |r| binning.bin(r.centroid(binning.axis)) < bin);
+            debug_assert!(0 < mid && mid < n);
+            return Some((mid, l, r));
         }
         Split::Sorted(axis, mid) => {
             refs.select_nth_unstable_by(mid, |a, b| {
                 a.centroid(axis)
                     .total_cmp(&b.centroid(axis))
-                    .then(a.id.cmp(&b.id))
+                    .then(a.id().cmp(&b.id()))
             });
             mid
         }
@@ -270,7 +287,11 @@ fn split(refs: &mut [PrimRef], nb: &NodeBounds, depth: u32, root_area: f64) -> O
         Split::Halve => n / 2,
     };
     debug_assert!(0 < mid && mid < n);
-    Some(mid)
+    Some((
+        mid,
+        NodeBounds::of(&refs[..mid]),
+        NodeBounds::of(&refs[mid..]),
+    ))
 }
 
 /// Picks how to split a node of `refs.len()` triangles with bounds `nb`, in a tree whose root
@@ -373,10 +394,8 @@ fn binned_sah(refs: &[PrimRef], c: &Bounds) -> (Option<f64>, Option<Split>) {
 fn small_sah(refs: &[PrimRef], c: &Bounds) -> (Option<f64>, Option<Split>) {
     let n = refs.len();
     debug_assert!(n <= SMALL_NODE);
-    let centroids: [[f32; 3]; SMALL_NODE] = std::array::from_fn(|i| {
-        refs.get(i)
-            .map_or([0.0; 3], |r| (r.min * 0.5 + r.max * 0.5).to_array())
-    });
+    let centroids: [[f32; 3]; SMALL_NODE] =
+        std::array::from_fn(|i| refs.get(i).map_or([0.0; 3], |r| r.centre().to_array()));
     let mut best: Option<(f64, [u8; SMALL_NODE], usize)> = None;
     let mut right_cost = [0f64; SMALL_NODE];
     for axis in 0..3 {
@@ -393,20 +412,23 @@ fn small_sah(refs: &[PrimRef], c: &Bounds) -> (Option<f64>, Option<Split>) {
             } else {
                 bits | 1 << 31
             };
-            *key = ((u64::from(ordered) << 32) | u64::from(refs[i].id), i as u8);
+            *key = (
+                (u64::from(ordered) << 32) | u64::from(refs[i].id()),
+                i as u8,
+            );
         }
         keys[..n].sort_unstable_by_key(|k| k.0);
         let order: [u8; SMALL_NODE] = keys.map(|k| k.1);
         let mut acc = Bounds::EMPTY;
         for k in (1..n).rev() {
             let r = &refs[order[k] as usize];
-            acc.grow(r.min, r.max);
+            acc.grow(r.min(), r.max());
             right_cost[k] = acc.area() * (n - k) as f64;
         }
         let mut acc = Bounds::EMPTY;
         for k in 1..n {
             let (prev, next) = (order[k - 1] as usize, order[k] as usize);
-            acc.grow(refs[prev].min, refs[prev].max);
+            acc.grow(refs[prev].min(), refs[prev].max());
             // Cut only between distinct centroids, so each half's centroid box shrinks.
             if centroids[prev][axis] == centroids[next][axis] {
                 continue;
@@ -424,21 +446,30 @@ fn small_sah(refs: &[PrimRef], c: &Bounds) -> (Option<f64>, Option<Split>) {
 }
 
 /// Moves the entries for which `left` holds to the front (in a fixed order: the result depends
-/// only on the input) and returns how many there are.
-fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool) -> usize {
+/// only on the input) and returns how many there are, with the bounds of both parts (gathered
+/// on the way: min and max, the same in any order).
+fn partition(
+    refs: &mut [PrimRef],
+    left: impl Fn(&PrimRef) -> bool,
+) -> (usize, NodeBounds, NodeBounds) {
+    let (mut lb, mut rb) = (Grow::EMPTY, Grow::EMPTY);
     let mut i = 0;
     let mut j = refs.len();
     loop {
         while i < j && left(&refs[i]) {
+            lb.add(&refs[i]);
             i += 1;
         }
         while i < j && !left(&refs[j - 1]) {
+            rb.add(&refs[j - 1]);
             j -= 1;
         }
         if i >= j {
-            return i;
+            return (i, lb.bounds(), rb.bounds());
         }
         refs.swap(i, j - 1);
+        lb.add(&refs[i]);
+        rb.add(&refs[j - 1]);
         i += 1;
         j -= 1;
     }
