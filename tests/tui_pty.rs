@@ -879,3 +879,51 @@ fn wrong_answers_are_not_believed_and_a_late_answer_is_not_keys() {
     s.send(b"\x1b");
     assert_eq!(s.finish().exit_code(), 0);
 }
+
+/// A model file that never finishes loading: a FIFO named `….ply` that nobody writes (opening
+/// it blocks), so the load is still under way whenever the test looks. Removed when dropped.
+struct StuckModel(std::path::PathBuf);
+
+impl StuckModel {
+    fn new(tag: &str) -> StuckModel {
+        let path =
+            std::env::temp_dir().join(format!("raytty-stuck-{tag}-{}.ply", std::process::id()));
+        let _ = std::fs::remove_file(&path);
+        let c = std::ffi::CString::new(path.to_str().expect("a UTF-8 temporary path"))
+            .expect("no NUL in the path");
+        // SAFETY: a valid C string; mkfifo only reads it.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+        StuckModel(path)
+    }
+}
+
+impl Drop for StuckModel {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+/// A load past half a second shows a bar on stderr; Ctrl-C then ends raytty with 130, the bar
+/// erased, no output file made, the terminal never taken (the app's) — in `render` and in the
+/// app.
+#[test]
+fn ctrl_c_during_a_models_load_exits_130_with_the_bar_cleared() {
+    let model = StuckModel::new("ctrl-c");
+    let path = model.0.to_str().expect("a UTF-8 temporary path");
+    let out = std::env::temp_dir().join(format!("raytty-stuck-{}.png", std::process::id()));
+    let out_s = out.to_str().expect("a UTF-8 temporary path");
+    for args in [vec![path, "render", "-o", out_s], vec![path]] {
+        let mut s = Session::start_with(100, 10, false, &args);
+        s.wait_for("the load's bar", |screen| {
+            screen.contents().contains("raytty: loading raytty-stuck-")
+                && screen.contents().contains(": reading")
+        });
+        s.send(b"\x03");
+        let status = s.finish();
+        let shown = s.screen.screen().contents();
+        assert_eq!(status.exit_code(), 130, "{args:?}: {shown}");
+        assert!(!shown.contains("loading"), "{args:?}: {shown}");
+        assert!(find(&s.raw, b"\x1b[?1049h").is_none(), "{args:?}");
+        assert!(!out.exists(), "{args:?}");
+    }
+}

@@ -5,6 +5,7 @@
 
 mod args;
 mod bench;
+mod loading;
 mod progress;
 mod render;
 pub mod scene_arg;
@@ -92,8 +93,8 @@ pub fn main() -> u8 {
 }
 
 /// The exit status of a run ended by signal `sig`: 128 + N, as shells report it. The app's
-/// forced exit after a signal (when its loop cannot return in time) uses this too.
-#[cfg(feature = "tui")]
+/// forced exit after a signal (when its loop cannot return in time) and a signal during a
+/// model's load (`loading.rs`) use this too.
 pub fn signal_status(sig: i32) -> u8 {
     (128 + sig).clamp(0, 255) as u8
 }
@@ -227,7 +228,8 @@ fn run_default(
                     raytty::printable(scene.unwrap_or("the Cornell box"))
                 );
             }
-            let loaded = crate::cli::scene_arg::load_scene(scene, view);
+            // The load's watch ends here: the app installs its own signal handlers.
+            let loaded = crate::cli::scene_arg::load_scene(scene, view).map(|(s, _watch)| s);
             if note {
                 eprint!("\r\x1b[2K");
             }

@@ -98,7 +98,8 @@ pub(super) fn run_render(
             pixels * 48 / (1024 * 1024)
         );
     }
-    let mut scene = crate::cli::scene_arg::load_scene(scene, view)?;
+    // Watched until the render is written: Ctrl-C ends it with 130 (`loading.rs`).
+    let (mut scene, _watch) = crate::cli::scene_arg::load_scene(scene, view)?;
     if let Some(isa) = args.simd {
         let available: Vec<_> = raytty::simd::Isa::ALL
             .into_iter()

@@ -10,22 +10,25 @@ use raytty::scene::file;
 use raytty::scene::model::{self, Format, View};
 use raytty::{Scene, printable};
 
+use crate::cli::loading::Watch;
 use crate::cli::{Failure, Result, usage};
 
 /// The scene `arg` names (the Cornell box when there is none), seen through `view`. A model's
-/// notes (what the file has that is not drawn) go to stderr, one line each.
-pub fn load_scene(arg: Option<&str>, view: &View) -> Result<Scene> {
-    let scene = find_scene(arg, view)?;
+/// notes (what the file has that is not drawn) go to stderr, one line each. A model's load is
+/// watched (a progress bar, Ctrl-C): the [`Watch`] keeps watching the signals until dropped.
+pub fn load_scene(arg: Option<&str>, view: &View) -> Result<(Scene, Option<Watch>)> {
+    let mut watch = None;
+    let scene = find_scene(arg, view, &mut watch)?;
     if Format::of(Path::new(arg.unwrap_or_default())).is_some() {
-        return Ok(scene);
+        return Ok((scene, watch));
     }
     let camera = view
         .apply(scene.camera())
         .map_err(|e| Failure::Usage(e.to_string()))?;
-    Ok(scene.with_camera(camera))
+    Ok((scene.with_camera(camera), watch))
 }
 
-fn find_scene(arg: Option<&str>, view: &View) -> Result<Scene> {
+fn find_scene(arg: Option<&str>, view: &View, watch: &mut Option<Watch>) -> Result<Scene> {
     let Some(arg) = arg else {
         return Ok(raytty::cornell_box());
     };
@@ -46,7 +49,13 @@ fn find_scene(arg: Option<&str>, view: &View) -> Result<Scene> {
         );
     }
     if Format::of(path).is_some() {
-        let loaded = model::load(path, view).map_err(|e| Failure::Usage(e.to_string()))?;
+        let name = path
+            .file_name()
+            .map_or_else(|| printable(arg), |n| printable(&n.to_string_lossy()));
+        let w = watch.insert(Watch::start(&name));
+        let loaded = model::load_with(path, view, w.progress());
+        w.loaded();
+        let loaded = loaded.map_err(|e| Failure::Usage(e.to_string()))?;
         for note in &loaded.notes {
             eprintln!("raytty: {}: {}", printable(arg), printable(note));
         }

@@ -34,7 +34,7 @@ pub(super) fn run_bench(
         };
         check_sizes(&sizes)?;
         let start = std::time::Instant::now();
-        let scene = crate::cli::scene_arg::load_scene(Some(name), view)?;
+        let (scene, _watch) = crate::cli::scene_arg::load_scene(Some(name), view)?;
         let load = start.elapsed();
         let runs = a.runs.unwrap_or(if a.quick { 2 } else { 5 });
         let bench = raytty::bench::scene::bench_scene(&scene, &sizes, runs);

@@ -15,7 +15,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{Model, check_triangles, srgb_to_linear};
+use super::{LoadProgress, LoadStep, Model, check_triangles, srgb_to_linear};
 use crate::scene::file::SceneFileError;
 
 /// A property's scalar type.
@@ -150,8 +150,19 @@ enum Encoding {
 
 /// Reads `bytes` as a PLY model named `file`.
 pub fn parse(bytes: &[u8], file: &str) -> Result<Model, SceneFileError> {
+    parse_with(bytes, file, &LoadProgress::new())
+}
+
+/// [`parse`], counting the records read in `progress`.
+pub fn parse_with(
+    bytes: &[u8],
+    file: &str,
+    progress: &LoadProgress,
+) -> Result<Model, SceneFileError> {
     let (encoding, elements, body) = header(bytes, file)?;
     let mut model = Model::default();
+    let records = elements.iter().map(|e| e.count as u64).sum::<u64>();
+    progress.start(LoadStep::Parsing, records);
     let mut reader = Body {
         bytes,
         at: body,
@@ -159,6 +170,8 @@ pub fn parse(bytes: &[u8], file: &str) -> Result<Model, SceneFileError> {
         file,
         line: 0,
         line_start: body,
+        progress,
+        records: 0,
     };
     if encoding == Encoding::Ascii {
         reader.line = bytes[..body].iter().filter(|&&b| b == b'\n').count() + 1;
@@ -208,6 +221,7 @@ pub fn parse(bytes: &[u8], file: &str) -> Result<Model, SceneFileError> {
                         reader.skip(p, &e.name, i)?;
                     }
                     reader.end_record()?;
+                    reader.counted();
                 }
             }
         }
@@ -295,6 +309,7 @@ fn vertex_element(r: &mut Body, e: &Element, model: &mut Model) -> Result<(), Sc
             }
         }
         r.end_record()?;
+        r.counted();
         push(model, p, n, t, c);
     }
     Ok(())
@@ -348,6 +363,7 @@ fn binary_vertices(
         }
         push(model, p, n, t, c);
         r.at += stride;
+        r.counted();
     }
     records
 }
@@ -402,6 +418,7 @@ fn face_element(
             }
         }
         r.end_record()?;
+        r.counted();
     }
     Ok(())
 }
@@ -449,6 +466,7 @@ fn binary_faces(r: &mut Body, e: &Element, vertices: usize, model: &mut Model) -
             model.triangles.push([face[0], face[k], face[k + 1]]);
         }
         r.at += cs + n * is;
+        r.counted();
     }
     e.count
 }
@@ -588,9 +606,21 @@ struct Body<'a> {
     /// ASCII: the 1-based line of `at` and where that line starts.
     line: usize,
     line_start: usize,
+    /// Where the records read are counted, and their count.
+    progress: &'a LoadProgress,
+    records: u64,
 }
 
 impl Body<'_> {
+    /// Counts a record read (told to the progress every 64K).
+    #[inline]
+    fn counted(&mut self) {
+        self.records += 1;
+        if self.records.is_multiple_of(1 << 16) {
+            self.progress.set_done(self.records);
+        }
+    }
+
     /// An error at byte `at`: its line and column in an ASCII body, its offset in a binary one.
     fn error(&self, at: usize, message: String) -> SceneFileError {
         if self.encoding == Encoding::Ascii {
