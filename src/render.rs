@@ -46,6 +46,12 @@ pub struct Options<'a> {
     pub width: u32,
     /// The frame's height in pixels.
     pub height: u32,
+    /// Only these rows of the frame, `(first, count)`: the image is `width × count`, each
+    /// pixel bit for bit the whole frame's (a pixel's samples depend on the pixel, not on
+    /// what else is rendered), so frames rendered in parts join into the whole one. Rows past
+    /// `height` are left out. The denoiser filters what it is given: a part denoised alone
+    /// differs from the whole frame's near its edges. `None`: every row.
+    pub rows: Option<(u32, u32)>,
     /// What is computed: the shading mode, the effects (samples per pixel and their sampler
     /// among them) and the frame number that seeds the random numbers. `None`: the default
     /// stage ([`Stage::Indirect`]) of the scene's own effects.
@@ -137,11 +143,11 @@ pub struct HitCache {
     hits: Vec<Option<Hit>>,
 }
 
-/// The camera ([`Camera::key`]) and the frame's size.
-type CacheKey = ([u32; 15], u32, u32);
+/// The camera ([`Camera::key`]), the frame's size and the rows rendered (first, count).
+type CacheKey = ([u32; 15], u32, u32, u32, u32);
 
-fn cache_key(c: &Camera, width: u32, height: u32) -> CacheKey {
-    (c.key(), width, height)
+fn cache_key(c: &Camera, width: u32, height: u32, top: u32, rows: u32) -> CacheKey {
+    (c.key(), width, height, top, rows)
 }
 
 impl HitCache {
@@ -179,6 +185,9 @@ struct Job<'a> {
     camera: Camera,
     rays: RayGen,
     width: usize,
+    /// The whole frame's height; the rows rendered are `height` of them from `top`.
+    frame_height: u32,
+    top: usize,
     height: usize,
     /// Samples per pixel (at least 1).
     samples: u32,
@@ -203,13 +212,19 @@ impl<'a> Job<'a> {
         } else {
             Sampler::Independent
         };
+        let (top, count) = options.rows.map_or((0, options.height), |(first, count)| {
+            let first = first.min(options.height);
+            (first, count.min(options.height - first))
+        });
         Job {
             scene,
             tracer,
             camera,
             rays: camera.rays(options.width, options.height),
             width: options.width as usize,
-            height: options.height as usize,
+            frame_height: options.height,
+            top: top as usize,
+            height: count as usize,
             samples: settings.effects.samples.max(1),
             sampler,
             frame: settings.frame,
@@ -248,7 +263,7 @@ impl<'a> Job<'a> {
 fn render(scene: &Scene, options: &Options, cache: Option<&mut HitCache>) -> Frame {
     let start = Instant::now();
     let job = Job::new(scene, options);
-    let (width, height) = (options.width, options.height);
+    let (width, height) = (options.width, job.height as u32);
     let (w, h) = (job.width, job.height);
     // A streamed frame of one sample goes out band by band from each thread's own rows.
     let own_rows = job.done.is_some() && job.samples == 1;

@@ -206,6 +206,23 @@ pub(super) enum Command {
     Bench(BenchArgs),
     /// List the built-in scenes with their triangle counts.
     Scenes,
+    /// Join the tiles of `raytty render --tile I/N` into the frame: byte for byte the image
+    /// one render would write.
+    Merge(MergeArgs),
+}
+
+/// Options of `raytty merge`.
+#[derive(Args, Debug)]
+pub(super) struct MergeArgs {
+    /// The tiles (PFM files from `raytty render --tile I/N -o TILE.pfm`), in any order.
+    #[arg(value_name = "TILE", required = true)]
+    pub(super) tiles: Vec<PathBuf>,
+    /// The frame: a .png (through the frame's tone map) or .pfm file.
+    #[arg(short, long, value_name = "FILE")]
+    pub(super) output: PathBuf,
+    /// How radiance is shown in PNG: none or neutral (default: the tiles' own, their scene's).
+    #[arg(long, value_name = "none|neutral", value_parser = parse_tonemap)]
+    pub(super) tonemap: Option<raytty::image::ToneMap>,
 }
 
 /// Options of `raytty bench`.
@@ -323,6 +340,11 @@ pub(super) struct RenderArgs {
     /// Write to FILE instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub(super) output: Option<PathBuf>,
+    /// Render only tile I of N (I from 0 to N-1): a band of whole rows of the frame, written
+    /// as PFM for `raytty merge`, which joins the N tiles into exactly the frame one render
+    /// gives. Not with the denoiser (--denoise off): it reads across the tiles' edges.
+    #[arg(long, value_name = "I/N", value_parser = parse_tile)]
+    pub(super) tile: Option<(u32, u32)>,
     /// After the frame, print one line to stderr: render time in ms, samples per pixel, rays
     /// by kind, M rays/s and the SIMD path; --stats=json prints it as one JSON object (keys ms,
     /// spp, rays, mrays_per_s, simd, threads).
@@ -374,6 +396,18 @@ pub(super) fn parse_size(s: &str) -> Result<(u32, u32), String> {
         return Err(bad());
     }
     Ok((w, h))
+}
+
+pub(super) fn parse_tile(s: &str) -> Result<(u32, u32), String> {
+    let bad =
+        || format!("'{s}' is not a tile: expected I/N, I from 0 to N-1 and N from 1, e.g. 0/8");
+    let (i, n) = s.split_once('/').ok_or_else(bad)?;
+    let i: u32 = i.trim().parse().map_err(|_| bad())?;
+    let n: u32 = n.trim().parse().map_err(|_| bad())?;
+    if n == 0 || i >= n {
+        return Err(bad());
+    }
+    Ok((i, n))
 }
 
 pub(super) fn parse_sampler(s: &str) -> Result<Sampler, String> {

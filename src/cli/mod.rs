@@ -9,6 +9,7 @@ mod loading;
 mod progress;
 mod render;
 pub mod scene_arg;
+mod tiles;
 
 #[cfg(feature = "tui")]
 use std::io::IsTerminal;
@@ -60,6 +61,7 @@ pub fn main() -> u8 {
             let cells = args.cells.map(|c| resolve_cells(c, env));
             run_render(&args, scene, &view, no_color, colors, cells).map(|()| 0)
         }
+        Some(Command::Merge(a)) => tiles::run_merge(&a).map(|()| 0),
         Some(Command::Scenes) => stdout_is_open("the list").and_then(|()| {
             io::stdout()
                 .write_all(crate::cli::scene_arg::list().as_bytes())
@@ -261,6 +263,7 @@ fn run_default(
             light: None,
             tonemap: None,
             output: None,
+            tile: None,
             stats: None,
             simd: None,
             estimator: None,

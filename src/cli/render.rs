@@ -98,6 +98,15 @@ pub(super) fn run_render(
             pixels * 48 / (1024 * 1024)
         );
     }
+    let tile = match args.tile {
+        Some(part) if format != Format::Pfm => usage!(
+            "--tile {}/{}: a tile is written as PFM (linear values, exact) for raytty merge: give -o NAME.pfm",
+            part.0,
+            part.1
+        ),
+        Some(part) => Some((part, crate::cli::tiles::rows_of(part, h)?)),
+        None => None,
+    };
     // Watched until the render is written: Ctrl-C ends it with 130 (`loading.rs`).
     let (mut scene, _watch) = crate::cli::scene_arg::load_scene(scene, view)?;
     if let Some(isa) = args.simd {
@@ -142,6 +151,21 @@ pub(super) fn run_render(
         )
         .into());
     }
+    let options = Options {
+        width: w,
+        height: h,
+        settings: Some(settings),
+        camera: Some(camera),
+        lights: Some(&lights),
+        rows: tile.map(|(_, rows)| rows),
+        ..Options::default()
+    };
+    let denoised = args.denoise == Switch::On && options.denoises(&scene);
+    if let (Some(((i, n), _)), true) = (tile, denoised) {
+        usage!(
+            "--tile {i}/{n}: the denoiser reads pixels across a tile's edges, so denoised tiles would not join into the frame: add --denoise off (with many samples per pixel it changes little)"
+        );
+    }
     // The output file is opened before the (maybe long) render, so a bad path fails at once.
     // It is not truncated here but after the write, to the length written: an existing file's
     // pages are overwritten in place rather than freed and allocated again (a few ms for a
@@ -161,19 +185,12 @@ pub(super) fn run_render(
         Some(f) => Box::new(BufWriter::new(f)),
         None => Box::new(BufWriter::new(io::stdout().lock())),
     };
-    let options = Options {
-        width: w,
-        height: h,
-        settings: Some(settings),
-        camera: Some(camera),
-        lights: Some(&lights),
-        ..Options::default()
-    };
-    let denoised = args.denoise == Switch::On && options.denoises(&scene);
     // A PFM file that is not denoised afterwards is written band by band as the render
     // finishes them, on the render's threads: the write overlaps the rest of the render.
     let streamed = match &file {
-        Some(f) if format == Format::Pfm && !denoised && f.metadata()?.is_file() => {
+        Some(f)
+            if format == Format::Pfm && !denoised && tile.is_none() && f.metadata()?.is_file() =>
+        {
             Some(PfmBands::start(f, w, h).with_context(|| cannot_write(args))?)
         }
         _ => None,
@@ -196,7 +213,11 @@ pub(super) fn run_render(
             let tone = args.tonemap.unwrap_or(scene.tone_map());
             let written = match format {
                 Format::Png => tone.image(&frame.image).write_png(&mut out),
-                Format::Pfm => frame.image.write_pfm(&mut out),
+                Format::Pfm => frame.image.write_pfm(&mut out).and_then(|()| match tile {
+                    Some((part, rows)) => out
+                        .write_all(crate::cli::tiles::trailer(part, rows, (w, h), tone).as_bytes()),
+                    None => Ok(()),
+                }),
                 Format::Ansi | Format::Ansi256 | Format::Ascii => {
                     let mode = match format {
                         Format::Ansi => ColorMode::TrueColor,

@@ -28,7 +28,13 @@ pub(super) fn render(
 ) -> RayCounts {
     let (w, h) = (job.width, job.height);
     let bands = h.div_ceil(TILE);
-    let key = Some(cache_key(&job.camera, w as u32, h as u32));
+    let key = Some(cache_key(
+        &job.camera,
+        w as u32,
+        job.frame_height,
+        job.top as u32,
+        h as u32,
+    ));
     let reuse = cache
         .as_ref()
         .is_some_and(|c| c.key == key && c.hits.len() == w * h);
@@ -73,7 +79,7 @@ pub(super) fn render(
             let y0 = band * TILE;
             frame.band(
                 &mut tiles,
-                y0,
+                job.top + y0,
                 pixels,
                 hits.as_deref_mut(),
                 guide_rows,
@@ -140,8 +146,8 @@ impl<'j, 'a> OneSample<'j, 'a> {
         }
     }
 
-    /// The band of rows from `y0` (`guide_rows.len()` of them) into `pixels`, its hits from or
-    /// into `hits` (the cache's rows) if there are any.
+    /// The band of the frame's rows from `y0` (`guide_rows.len()` of them) into `pixels`, its
+    /// hits from or into `hits` (the cache's rows) if there are any.
     fn band(
         &self,
         t: &mut Tiles,

@@ -24,7 +24,9 @@ pub(super) fn render(
         .par_chunks_mut(w)
         .zip(guide_rows.par_iter_mut())
         .enumerate()
-        .map(|(y, (row, guide_row))| {
+        .map(|(row_index, (row, guide_row))| {
+            // The frame's row (the rows rendered may start below its top).
+            let y = job.top + row_index;
             let mut n = RayCounts::default();
             for (x, px) in row.iter_mut().enumerate() {
                 let mut acc = Vec3::ZERO;
@@ -44,7 +46,7 @@ pub(super) fn render(
                 }
             }
             if let Some(done) = job.done {
-                done(y as u32, row);
+                done(row_index as u32, row);
             }
             n
         })

@@ -103,7 +103,8 @@ pub(super) fn render(job: &Job, pixels: &mut [Vec3]) -> RayCounts {
             let Some((band, pixels)) = next else {
                 return n;
             };
-            let (y0, rows) = (band * TILE, pixels.len() / w);
+            // `y0`: the frame's row (the rows rendered may start below its top).
+            let (y0, rows) = (job.top + band * TILE, pixels.len() / w);
             for x0 in (0..w).step_by(TILE) {
                 let cols = (w - x0).min(TILE);
                 let k = cols * rows;
@@ -175,7 +176,7 @@ pub(super) fn render(job: &Job, pixels: &mut [Vec3]) -> RayCounts {
                 }
             }
             if let Some(done) = done {
-                done(y0 as u32, pixels);
+                done((band * TILE) as u32, pixels);
             }
         }
     })
