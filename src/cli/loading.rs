@@ -14,7 +14,7 @@ use std::sync::mpsc::{self, RecvTimeoutError, Sender};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle, TermLike};
 use raytty::scene::model::LoadProgress;
 use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
 use signal_hook::iterator::Signals;
@@ -79,7 +79,11 @@ impl Watch {
                     bar = io::stderr().is_terminal().then(|| {
                         // The bar takes the line (the app's "loading" note may be on it).
                         eprint!("\r\x1b[2K");
-                        ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr())
+                        let stderr = Box::new(Narrower(console::Term::stderr()));
+                        ProgressBar::with_draw_target(
+                            Some(1000),
+                            ProgressDrawTarget::term_like(stderr),
+                        )
                     });
                 }
                 if let Some(bar) = &bar {
@@ -136,8 +140,49 @@ fn draw(bar: &ProgressBar, counted: &mut Option<bool>, name: &str, progress: &Lo
         Some(f) => bar.set_position((f * 1000.0) as u64),
         None => bar.tick(),
     }
-    // indicatif leaves the cursor at the right edge, where the terminal's echo of a typed ^C
-    // would wrap to a line of its own and the bar's line would stay when cleared: back to its
-    // start, the echo lands on the bar's line and goes with it.
-    eprint!("\r");
+}
+
+/// stderr as the bar draws on it, two columns narrower than the terminal. indicatif pads a
+/// line to the right edge, where the terminal's echo of a typed ^C would wrap to a line of its
+/// own, and clearing the bar would leave the bar's line behind; two columns short, the echo
+/// stays on the bar's line and goes with it.
+#[derive(Debug)]
+struct Narrower(console::Term);
+
+impl TermLike for Narrower {
+    fn width(&self) -> u16 {
+        self.0.size().1.saturating_sub(2).max(1)
+    }
+
+    fn move_cursor_up(&self, n: usize) -> io::Result<()> {
+        self.0.move_cursor_up(n)
+    }
+
+    fn move_cursor_down(&self, n: usize) -> io::Result<()> {
+        self.0.move_cursor_down(n)
+    }
+
+    fn move_cursor_right(&self, n: usize) -> io::Result<()> {
+        self.0.move_cursor_right(n)
+    }
+
+    fn move_cursor_left(&self, n: usize) -> io::Result<()> {
+        self.0.move_cursor_left(n)
+    }
+
+    fn write_line(&self, s: &str) -> io::Result<()> {
+        self.0.write_line(s)
+    }
+
+    fn write_str(&self, s: &str) -> io::Result<()> {
+        self.0.write_str(s)
+    }
+
+    fn clear_line(&self) -> io::Result<()> {
+        self.0.clear_line()
+    }
+
+    fn flush(&self) -> io::Result<()> {
+        self.0.flush()
+    }
 }
