@@ -90,8 +90,8 @@ def mitsuba_scene(mi, spec, export_dir, width, height, spp, max_depth):
         "integrator": {"type": "path", "max_depth": max_depth},
         "sensor": {
             "type": "perspective",
-            "fov": cam["fov_smaller_side_degrees"],
-            "fov_axis": "smaller",
+            "fov": cam["fov_degrees"],
+            "fov_axis": cam["fov_axis"],
             "to_world": mi.ScalarTransform4f().look_at(origin=origin, target=target, up=up),
             "film": {
                 "type": "hdrfilm",

@@ -16,9 +16,15 @@ fn main() {
         eprintln!("usage: mitsuba SCENE OUT_DIR");
         std::process::exit(2);
     };
+    let path = Path::new(name);
     let scene = match builtin::find(name) {
         Some(b) => b.load().map_err(|e| e.to_string()),
-        None => raytty::scene::file::load(Path::new(name)).map_err(|e| e.to_string()),
+        None if raytty::scene::model::Format::of(path).is_some() => {
+            raytty::scene::model::load(path, &raytty::scene::model::View::default())
+                .map(|l| l.scene)
+                .map_err(|e| e.to_string())
+        }
+        None => raytty::scene::file::load(path).map_err(|e| e.to_string()),
     }
     .unwrap_or_else(|e| {
         eprintln!("{name}: {e}");
@@ -87,7 +93,7 @@ fn main() {
     let (p, f, d) = (cam.position, cam.forward(), cam.down());
     let json = format!(
         "{{\n  \"scene\": \"{name}\",\n  \"camera\": {{\"origin\": [{}, {}, {}], \"forward\": [{}, {}, {}], \
-         \"down\": [{}, {}, {}], \"fov_smaller_side_degrees\": {}}},\n  \"materials\": [\n{materials}\n  ],\n  \
+         \"down\": [{}, {}, {}], \"fov_degrees\": {}, \"fov_axis\": \"{}\"}},\n  \"materials\": [\n{materials}\n  ],\n  \
          \"lights\": [\n{}\n  ]\n}}\n",
         p.x,
         p.y,
@@ -98,8 +104,12 @@ fn main() {
         d.x,
         d.y,
         d.z,
-        // The focal length is the shorter side in pixels: 2·atan(1/2) across it.
-        2.0 * 0.5f64.atan().to_degrees(),
+        // The seed's focal length is the shorter side in pixels: 2·atan(1/2) across it; a
+        // model's camera has a vertical field of view.
+        cam.fov
+            .map_or(2.0 * 0.5f64.atan().to_degrees(), |f| f64::from(f)
+                .to_degrees()),
+        if cam.fov.is_some() { "y" } else { "smaller" },
         lights.join(",\n")
     );
     std::fs::write(out.join("scene.json"), json).unwrap();
