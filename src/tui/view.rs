@@ -385,13 +385,7 @@ impl Screen {
         let outcome = encode_diff_within(&mut self.shown, &grid, 0, limits, &mut out);
         self.next_row = outcome.next_row;
         self.approximate = !outcome.complete || outcome.max_error > 0;
-        if out.len() == SYNC_BEGIN.len() {
-            return Vec::new();
-        }
-        out.extend_from_slice(SYNC_END);
-        self.stats.encode = start.elapsed();
-        self.stats.bytes = out.len();
-        out
+        self.finish(out, start)
     }
 
     /// Removes the image from the screen (kitty: deleted; sixel: the screen cleared) and
@@ -442,6 +436,12 @@ impl Screen {
             DiffLimits::EXACT,
             &mut out,
         );
+        self.finish(out, start)
+    }
+
+    /// A frame's bytes closed by the end of synchronized output, its encode time and size
+    /// counted; nothing at all when nothing changed (`out` holds only the begin marker).
+    fn finish(&mut self, mut out: Vec<u8>, start: Instant) -> Vec<u8> {
         if out.len() == SYNC_BEGIN.len() {
             return Vec::new();
         }

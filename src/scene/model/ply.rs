@@ -75,33 +75,31 @@ impl Scalar {
     /// The value of `raw` (this type's size in bytes) in a binary body of byte order `big`.
     #[inline]
     fn decode(self, raw: &[u8], big: bool) -> f64 {
+        let b = self.le_bytes(raw, big);
+        match self {
+            Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            Scalar::F64 => f64::from_le_bytes(b),
+            // Every integer type's values are exact in `f64`.
+            _ => self.decode_int(raw, big) as f64,
+        }
+    }
+
+    /// This type's bytes of `raw` in little-endian order, in the first [`Scalar::size`] of eight.
+    #[inline]
+    fn le_bytes(self, raw: &[u8], big: bool) -> [u8; 8] {
         let size = self.size();
         let mut b = [0u8; 8];
         b[..size].copy_from_slice(&raw[..size]);
         if big {
             b[..size].reverse();
         }
-        match self {
-            Scalar::I8 => b[0] as i8 as f64,
-            Scalar::U8 => b[0] as f64,
-            Scalar::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
-            Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
-            Scalar::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-            Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-            Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-            Scalar::F64 => f64::from_le_bytes(b),
-        }
+        b
     }
 
     /// [`Scalar::decode`] for an integer type, exactly.
     #[inline]
     fn decode_int(self, raw: &[u8], big: bool) -> i64 {
-        let size = self.size();
-        let mut b = [0u8; 8];
-        b[..size].copy_from_slice(&raw[..size]);
-        if big {
-            b[..size].reverse();
-        }
+        let b = self.le_bytes(raw, big);
         match self {
             Scalar::I8 => b[0] as i8 as i64,
             Scalar::U8 => b[0] as i64,
