@@ -248,7 +248,7 @@ fn chafa(reference: &Image, cols: u32, rows: u32) {
     {
         return;
     }
-    for symbols in ["half", "quad", "sextant", "octant"] {
+    for symbols in ["hhalf", "half", "quad", "sextant", "octant"] {
         let start = Instant::now();
         let Ok(out) = Command::new("chafa")
             .args([
