@@ -466,14 +466,19 @@ impl Screen {
         // The price, live: the time spent on this image and its error estimated from the
         // per-pixel variance (denoised: the noise left after the filter, then the raw one's).
         let (raw, shown) = self.error;
+        // The physically based path's light is not in the denoiser's guides yet (it is neither
+        // filtered nor in the variance estimate): its frames show the time alone.
+        let unguided = gi && raytty::shading::PathEffects::of(&app.scene).any();
         let price = if !gi {
             String::new()
+        } else if unguided {
+            format!("{:.2}s", self.spent.as_secs_f64())
         } else if app.denoise {
             format!("{:.2}s ±{shown:.4} raw ±{raw:.3}", self.spent.as_secs_f64())
         } else {
             format!("{:.2}s ±{raw:.4}", self.spent.as_secs_f64())
         };
-        let filter = match (gi, app.denoise) {
+        let filter = match (gi && !unguided, app.denoise) {
             (false, _) => String::new(),
             (true, true) => "N:denoised".to_string(),
             (true, false) => "N:raw".to_string(),
