@@ -15,7 +15,7 @@
 
 use super::{Cell, CellGrid, ColorMode, Colour, luminance, nearest_256, palette_rgb, ramp};
 use crate::image::Image;
-use crate::simd::Isa;
+use crate::simd::{Isa, Kernel, Path};
 
 /// How many pixels a cell shows, and with which glyphs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -425,25 +425,19 @@ fn fit_grid(
     mode: CellMode,
     color: ColorMode,
 ) -> CellGrid {
-    #[cfg(target_arch = "x86_64")]
-    if matches!(Isa::detect(), Isa::Avx2 | Isa::Avx512) {
-        // SAFETY: the CPU has AVX2.
-        return unsafe { fit_grid_avx2(rgb, width, height, mode, color) };
-    }
-    fit_cells(rgb, width, height, mode, color)
+    Isa::detect().run(Fit(rgb, width, height, mode, color))
 }
 
-/// [`fit_cells`] compiled for AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn fit_grid_avx2(
-    rgb: &[[u8; 3]],
-    width: usize,
-    height: usize,
-    mode: CellMode,
-    color: ColorMode,
-) -> CellGrid {
-    fit_cells(rgb, width, height, mode, color)
+/// [`fit_cells`] as a kernel of the one SIMD dispatch (AVX-512 CPUs run its AVX2 code).
+struct Fit<'a>(&'a [[u8; 3]], usize, usize, CellMode, ColorMode);
+
+impl Kernel for Fit<'_> {
+    type Output = CellGrid;
+    #[inline(always)]
+    fn run<P: Path>(self) -> CellGrid {
+        let Fit(rgb, width, height, mode, color) = self;
+        fit_cells(rgb, width, height, mode, color)
+    }
 }
 
 /// [`fit_grid`]'s body, inlined into each of its compilations.
@@ -606,8 +600,7 @@ mod tests {
                     .collect();
                 for color in [ColorMode::TrueColor, ColorMode::Ansi256] {
                     let portable = fit_cells(&rgb, width, height, mode, color);
-                    // SAFETY: the CPU has AVX2.
-                    let avx2 = unsafe { fit_grid_avx2(&rgb, width, height, mode, color) };
+                    let avx2 = Isa::Avx2.run(Fit(&rgb, width, height, mode, color));
                     assert_eq!(portable, avx2, "{mode:?} {color:?}");
                 }
             }
