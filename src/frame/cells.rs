@@ -396,18 +396,10 @@ fn cell_for(mode: CellMode, color: ColorMode, (mask, ink, bg): (u8, [u8; 3], [u8
         _ => Colour::Rgb(c[0], c[1], c[2]),
     };
     let (ink, bg) = (colour(ink), colour(bg));
-    if mask == 0 || ink == bg {
-        Cell {
-            ch: ' ',
-            fg: None,
-            bg: Some(bg),
-        }
+    if mask == 0 {
+        Cell::two(' ', bg, bg)
     } else {
-        Cell {
-            ch: mode.glyph(mask),
-            fg: Some(ink),
-            bg: Some(bg),
-        }
+        Cell::two(mode.glyph(mask), ink, bg)
     }
 }
 

@@ -244,22 +244,7 @@ fn quantize(cell: &Cell, tolerance: u8) -> Cell {
         c => c,
     };
     match pixels(cell) {
-        Some((ink, bg)) if tolerance > 0 => {
-            let (ink, bg) = (round(ink), round(bg));
-            if ink == bg {
-                Cell {
-                    ch: ' ',
-                    fg: None,
-                    bg: Some(bg),
-                }
-            } else {
-                Cell {
-                    ch: cell.ch,
-                    fg: Some(ink),
-                    bg: Some(bg),
-                }
-            }
-        }
+        Some((ink, bg)) if tolerance > 0 => Cell::two(cell.ch, round(ink), round(bg)),
         _ => *cell,
     }
 }

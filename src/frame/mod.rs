@@ -72,6 +72,26 @@ pub struct Cell {
     pub bg: Option<Colour>,
 }
 
+impl Cell {
+    /// `ch` in `ink` over `bg`: a space with only a background when the two are equal (the
+    /// glyph would not show).
+    pub(crate) fn two(ch: char, ink: Colour, bg: Colour) -> Cell {
+        if ink == bg {
+            Cell {
+                ch: ' ',
+                fg: None,
+                bg: Some(bg),
+            }
+        } else {
+            Cell {
+                ch,
+                fg: Some(ink),
+                bg: Some(bg),
+            }
+        }
+    }
+}
+
 /// The upper-half block: its foreground paints the cell's upper pixel.
 pub const UPPER_HALF: char = '▀';
 
@@ -111,19 +131,7 @@ impl CellGrid {
 /// A cell showing `up` over `lo`: a space with only a background when the two are equal.
 #[cfg(test)]
 fn half_block(up: Colour, lo: Colour) -> Cell {
-    if up == lo {
-        Cell {
-            ch: ' ',
-            fg: None,
-            bg: Some(lo),
-        }
-    } else {
-        Cell {
-            ch: UPPER_HALF,
-            fg: Some(up),
-            bg: Some(lo),
-        }
-    }
+    Cell::two(UPPER_HALF, up, lo)
 }
 
 /// The [`ASCII_RAMP`] character for a luminance of 0..=255.
