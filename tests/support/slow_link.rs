@@ -1,8 +1,13 @@
 //! A link emulator: runs a program in a pseudo-terminal and reads what it writes no faster than
 //! a given rate, as a terminal at the far end of a slow SSH connection would receive it. What is
 //! read goes through a terminal emulator (vt100), so the screen can be judged as a user sees
-//! it. Shared by `tests/tui_pty.rs` and `examples/slow_link.rs` (the bench).
+//! it, and the graphics escapes are kept (with when they arrived and where the cursor was) for
+//! the pixels they draw ([`graphics::PixelScreen`]). Shared by `tests/tui_pty.rs` and
+//! `examples/slow_link.rs` (the bench).
 #![allow(dead_code)]
+
+#[path = "graphics.rs"]
+pub mod graphics;
 
 use std::io::{Read, Write};
 use std::sync::{Arc, Mutex};
@@ -10,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system};
 use raytty::frame::{Colour, pixels};
-use raytty::{Camera, CellGrid, ColorMode, Options, PointLight, Stage, cornell_box};
+use raytty::{Camera, CellGrid, ColorMode, Image, Options, PointLight, Stage, cornell_box};
 
 /// The most the link lets through at once after an idle spell, in time at its rate (a real
 /// link's queue): long enough that the reader's own scheduling delays on a busy machine do not
@@ -31,6 +36,19 @@ pub struct Far {
     pub closed: bool,
     /// When the last bytes were read.
     pub last_read: Option<Instant>,
+    /// The graphics escapes read and not yet taken ([`SlowLink::take_graphics`]).
+    pub graphics: Vec<Escape>,
+}
+
+/// A graphics escape the far end read.
+pub struct Escape {
+    /// When its last byte was read.
+    pub at: Instant,
+    /// The bytes read up to the end of that read.
+    pub read: usize,
+    /// The cursor (row, column) where it began.
+    pub cursor: (u16, u16),
+    pub bytes: Vec<u8>,
 }
 
 /// A program on the far side of a link of `rate` bytes per second.
@@ -44,7 +62,7 @@ pub struct SlowLink {
 impl SlowLink {
     /// Starts `program` with `args` in a `cols × rows` pty drained at `rate` bytes per second.
     pub fn start(program: &str, args: &[&str], cols: u16, rows: u16, rate: f64) -> SlowLink {
-        SlowLink::start_with(program, args, cols, rows, rate, false)
+        SlowLink::start_with(program, args, (cols, rows), (0, 0), rate, false)
     }
 
     /// Like [`SlowLink::start`], but as over SSH: the pty is drained at once into a deep buffer
@@ -57,14 +75,27 @@ impl SlowLink {
         rows: u16,
         rate: f64,
     ) -> SlowLink {
-        SlowLink::start_with(program, args, cols, rows, rate, true)
+        SlowLink::start_with(program, args, (cols, rows), (0, 0), rate, true)
+    }
+
+    /// Like [`SlowLink::start`], in a terminal whose cells are `cell` pixels (as
+    /// `TIOCGWINSZ` tells the program).
+    pub fn start_with_cells(
+        program: &str,
+        args: &[&str],
+        cols: u16,
+        rows: u16,
+        cell: (u16, u16),
+        rate: f64,
+    ) -> SlowLink {
+        SlowLink::start_with(program, args, (cols, rows), cell, rate, false)
     }
 
     fn start_with(
         program: &str,
         args: &[&str],
-        cols: u16,
-        rows: u16,
+        (cols, rows): (u16, u16),
+        cell: (u16, u16),
         rate: f64,
         deep: bool,
     ) -> SlowLink {
@@ -72,8 +103,8 @@ impl SlowLink {
             .openpty(PtySize {
                 rows,
                 cols,
-                pixel_width: 0,
-                pixel_height: 0,
+                pixel_width: cols * cell.0,
+                pixel_height: rows * cell.1,
             })
             .expect("open a pty");
         let mut cmd = CommandBuilder::new(program);
@@ -116,6 +147,7 @@ impl SlowLink {
             bytes: 0,
             closed: false,
             last_read: None,
+            graphics: Vec::new(),
         }));
         let shared = far.clone();
         std::thread::spawn(move || {
@@ -124,6 +156,7 @@ impl SlowLink {
             let mut buf = vec![0u8; READ_MAX];
             // The end of the bytes delivered so far, for a query split between deliveries.
             let mut tail: Vec<u8> = Vec::new();
+            let mut splitter = graphics::Splitter::default();
             loop {
                 // A token bucket: what the link has carried by now, less what was read, at most
                 // a burst.
@@ -159,8 +192,21 @@ impl SlowLink {
                 read += n as f64;
                 let now = Instant::now();
                 let mut far = shared.lock().expect("the far end");
-                far.screen.process(&buf[..n]);
                 far.bytes += n;
+                for piece in splitter.split(&buf[..n]) {
+                    match piece {
+                        graphics::Piece::Text(t) => far.screen.process(t),
+                        graphics::Piece::Graphics(bytes) => {
+                            let escape = Escape {
+                                at: now,
+                                read: far.bytes,
+                                cursor: far.screen.screen().cursor_position(),
+                                bytes,
+                            };
+                            far.graphics.push(escape);
+                        }
+                    }
+                }
                 far.last_read = Some(now);
                 drop(far);
                 if deep {
@@ -211,6 +257,11 @@ impl SlowLink {
     pub fn snapshot(&self) -> (vt100::Screen, usize, Option<Instant>) {
         let far = self.far.lock().expect("the far end");
         (far.screen.screen().clone(), far.bytes, far.last_read)
+    }
+
+    /// The graphics escapes read since the last call, oldest first.
+    pub fn take_graphics(&self) -> Vec<Escape> {
+        std::mem::take(&mut self.far.lock().expect("the far end").graphics)
     }
 
     /// The pty's master side (to resize it).
@@ -270,15 +321,27 @@ pub fn max_error(screen: &vt100::Screen, want: &CellGrid) -> u16 {
 /// The image the app shows (truecolor, without its status line) in a `cols × rows` terminal
 /// with the Cornell box seen from `camera` under `lights`.
 pub fn app_image(camera: &Camera, lights: &[PointLight], cols: u16, rows: u16) -> CellGrid {
+    let image = app_render(camera, lights, u32::from(cols), 2 * (u32::from(rows) - 1));
+    CellGrid::from_image(&image, ColorMode::TrueColor)
+}
+
+/// The pixels the app shows in a pixel mode once exact (its image of `width × height`).
+pub fn app_pixels(camera: &Camera, lights: &[PointLight], width: u32, height: u32) -> Vec<[u8; 3]> {
+    app_render(camera, lights, width, height).to_rgb8()
+}
+
+/// The app's render of the Cornell box (its default stage, its tone map: none).
+fn app_render(camera: &Camera, lights: &[PointLight], width: u32, height: u32) -> Image {
     let scene = cornell_box();
     let settings = Stage::Indirect.settings(scene.effects());
-    let frame = scene.render(&Options {
-        width: u32::from(cols),
-        height: 2 * (u32::from(rows) - 1),
-        settings: Some(settings),
-        camera: Some(*camera),
-        lights: Some(lights),
-        ..Options::default()
-    });
-    CellGrid::from_image(&frame.image, ColorMode::TrueColor)
+    scene
+        .render(&Options {
+            width,
+            height,
+            settings: Some(settings),
+            camera: Some(*camera),
+            lights: Some(lights),
+            ..Options::default()
+        })
+        .image
 }
