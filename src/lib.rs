@@ -37,6 +37,8 @@ pub use geometry::{Ray, Triangle};
 pub use image::Image;
 pub use render::{BandDone, Frame, FrameStats, HitCache, Options, Output};
 pub use scene::cornell::cornell_box;
-pub use scene::{Effects, Indirect, Material, PointLight, Scene, SceneBuilder};
-pub use shading::{Mode, RayCounts, Settings, Stage, Tracer};
+pub use scene::{
+    DirectionalLight, Effects, Indirect, Material, PointLight, Scene, SceneBuilder, SpotLight,
+};
+pub use shading::{LightEffects, Mode, RayCounts, Settings, Stage, Tracer};
 pub use text::printable;

@@ -25,7 +25,7 @@ use crate::geometry::Ray;
 use crate::image::Image;
 use crate::sampler::{Sampler, Stream};
 use crate::scene::{PointLight, Scene};
-use crate::shading::{PathRun, RayCounts, Settings, Stage, Tracer};
+use crate::shading::{LightEffects, PathRun, RayCounts, Settings, Stage, Tracer};
 
 /// The side of a tile of camera rays traced together (`TILE`² = [`crate::accel::TILE_RAYS`]).
 const TILE: usize = 8;
@@ -120,6 +120,8 @@ pub struct FrameStats {
     pub elapsed: Duration,
     /// What the physically based path ran (`None`: the seed's shading).
     pub path: Option<PathRun>,
+    /// The kinds of light besides point lights and emitters that lit the frame.
+    pub lights: LightEffects,
 }
 
 /// A rendered frame.
@@ -304,6 +306,7 @@ fn render(scene: &Scene, options: &Options, cache: Option<&mut HitCache>) -> Fra
             samples: job.samples,
             elapsed: start.elapsed(),
             path: job.tracer.path_run(),
+            lights: job.tracer.light_effects(),
         },
         guides,
     };
@@ -316,6 +319,14 @@ fn render(scene: &Scene, options: &Options, cache: Option<&mut HitCache>) -> Fra
 }
 
 impl FrameStats {
+    /// The effects the frame ran beyond the seed's, by name: the physically based path's
+    /// ([`PathRun::names`]), then the kinds of light ([`LightEffects::names`]).
+    pub fn effect_names(&self) -> Vec<&'static str> {
+        let mut names = self.path.map_or(vec![], |p| p.names());
+        names.extend(self.lights.names());
+        names
+    }
+
     /// Millions of rays (all kinds) per second of the render's wall-clock time.
     pub fn mrays_per_s(&self) -> f64 {
         let s = self.elapsed.as_secs_f64();
@@ -330,9 +341,12 @@ impl FrameStats {
     /// physically based effects where the frame ran them.
     pub fn summary(&self, isa: crate::accel::Isa) -> String {
         let rays = self.rays.by_kind().map(|(kind, n)| format!("{n} {kind}"));
-        let effects = self.path.map_or(String::new(), |p| {
-            format!("; effects: {}", p.names().join(", "))
-        });
+        let names = self.effect_names();
+        let effects = if names.is_empty() {
+            String::new()
+        } else {
+            format!("; effects: {}", names.join(", "))
+        };
         format!(
             "{:.2} ms, {} spp, rays: {}; {:.2} M rays/s ({}, {} threads){effects}",
             self.elapsed.as_secs_f64() * 1e3,
@@ -351,10 +365,13 @@ impl FrameStats {
             .rays
             .by_kind()
             .map(|(kind, n)| format!("\"{kind}\":{n}"));
-        let effects = self.path.map_or(String::new(), |p| {
-            let names: Vec<String> = p.names().iter().map(|n| format!("\"{n}\"")).collect();
+        let names = self.effect_names();
+        let effects = if names.is_empty() {
+            String::new()
+        } else {
+            let names: Vec<String> = names.iter().map(|n| format!("\"{n}\"")).collect();
             format!(",\"effects\":[{}]", names.join(","))
-        });
+        };
         format!(
             "{{\"ms\":{:.3},\"spp\":{},\"rays\":{{{}}},\"mrays_per_s\":{:.3},\"simd\":\"{}\",\"threads\":{}{effects}}}",
             self.elapsed.as_secs_f64() * 1e3,

@@ -440,3 +440,113 @@ fn a_dark_light_costs_no_shadow_ray() {
     let s = stats(&scene, &settings(true, Indirect::Constant(0.5), 1));
     assert!(s.rays.shadow > 0);
 }
+
+/// A floor at y = 1 seen from above, with what `lights` adds.
+fn lit_floor(lights: impl FnOnce(&mut SceneBuilder)) -> Scene {
+    let mut b = SceneBuilder::new();
+    let m = b.material(Material::diffuse(Vec3::splat(0.75)));
+    let p = |x, z| Vec3::new(x, 1.0, z);
+    b.object(
+        [
+            [p(-9., -9.), p(9., 9.), p(-9., 9.)],
+            [p(-9., -9.), p(9., -9.), p(9., 9.)],
+        ],
+        m,
+    );
+    lights(&mut b);
+    let camera = Camera {
+        position: Vec3::new(0.0, -1.0, -1.0),
+        pitch: 1.0,
+        ..Camera::default()
+    };
+    b.build("floor", camera, Effects::SEED).unwrap()
+}
+
+/// A spot traces a shadow ray only where its cone reaches: fewer than the hits for a narrow
+/// cone, none pointing away; the control, a cone of 90 degrees over the floor, one per hit.
+#[test]
+fn a_spot_traces_no_shadow_ray_outside_its_cone() {
+    let spot = |direction: Vec3, outer: f32| {
+        lit_floor(|b| {
+            b.spot_light(raytty::SpotLight {
+                position: Vec3::new(0.0, -1.0, 1.0),
+                direction,
+                power: Vec3::splat(10.0),
+                inner: 0.0,
+                outer,
+            })
+        })
+    };
+    let s = settings(true, Indirect::None, 1);
+    let hits = (W * H) as u64;
+    let wide = stats(&spot(Vec3::Y, std::f32::consts::FRAC_PI_2), &s);
+    assert_eq!(wide.rays.shadow, hits);
+    let narrow = stats(&spot(Vec3::Y, 0.3), &s);
+    assert!(
+        narrow.rays.shadow > 0 && narrow.rays.shadow < hits / 2,
+        "{narrow:?}"
+    );
+    let away = stats(&spot(Vec3::NEG_Y, 1.0), &s);
+    assert_eq!(away.rays.shadow, 0);
+    assert_eq!(wide.effect_names(), ["spot lights"]);
+}
+
+/// A directional light from below the floor (behind every visible surface) costs no shadow
+/// ray; from above, one per hit.
+#[test]
+fn a_directional_light_behind_the_surface_costs_no_shadow_ray() {
+    let sun = |direction: Vec3| {
+        lit_floor(|b| {
+            b.directional_light(raytty::DirectionalLight {
+                direction,
+                irradiance: Vec3::ONE,
+            })
+        })
+    };
+    let s = settings(true, Indirect::None, 1);
+    let below = stats(&sun(Vec3::new(0.2, -1.0, 0.1)), &s);
+    assert_eq!(below.rays.shadow, 0);
+    let above = stats(&sun(Vec3::new(0.2, 1.0, 0.1)), &s);
+    assert_eq!(above.rays.shadow, (W * H) as u64);
+    assert_eq!(above.effect_names(), ["directional lights"]);
+}
+
+/// The environment costs no ray (it is what rays that leave the scene see): the same counts
+/// with and without it, in the seed's stages and in stage 6, diffuse or metal; `--stats`
+/// names it only where the scene has one and the frame shades.
+#[test]
+fn the_environment_costs_no_ray_and_is_named() {
+    for metal in [0.0, 1.0] {
+        let scene = |sky: f32| {
+            let mut b = SceneBuilder::new();
+            let m = b.material(Material {
+                metal,
+                roughness: 0.5,
+                ..Material::diffuse(Vec3::splat(0.75))
+            });
+            let p = |x, z| Vec3::new(x, 1.0, z);
+            b.object([[p(-1., -1.), p(1., 1.), p(-1., 1.)]], m);
+            b.light(PointLight {
+                position: Vec3::new(0.0, -1.0, 0.0),
+                power: Vec3::splat(5.0),
+            });
+            b.environment(Vec3::splat(sky));
+            let camera = Camera {
+                position: Vec3::new(0.0, -1.0, -1.0),
+                pitch: 0.8,
+                ..Camera::default()
+            };
+            b.build("sky", camera, Effects::SEED).unwrap()
+        };
+        let (dark, sky) = (scene(0.0), scene(0.4));
+        for stage in Stage::ALL {
+            let mut s = stage.settings(Effects::SEED);
+            s.effects.samples = 2;
+            let (a, b) = (stats(&dark, &s), stats(&sky, &s));
+            assert_eq!(a.rays, b.rays, "{stage:?} metal {metal}");
+            assert!(!a.effect_names().contains(&"environment"));
+            let named = b.effect_names().contains(&"environment");
+            assert_eq!(named, stage != Stage::Flat, "{stage:?}");
+        }
+    }
+}

@@ -404,3 +404,71 @@ fn columns_count_characters_in_meshes_as_in_scene_files() {
     says(&err, &d.join("scene.toml"), 1, 54, &[]);
     assert_eq!(under_caret(&err), '1', "{err}");
 }
+
+/// Directional, spot and environment lights: each mistake at its place (an unknown kind, a key
+/// of another kind, a missing key, a zero direction, a cone inside out or past 90 degrees).
+#[test]
+fn bad_light_kinds_and_values() {
+    let d = dir("light-kinds");
+    let file = d.join("scene.toml");
+    let cases: [(&str, usize, usize, &[&str]); 7] = [
+        (
+            "[[light]]\nkind = \"sun\"\ndirection = [0, 1, 0]\n",
+            2,
+            8,
+            &["unknown light kind `sun`", "directional, spot, environment"],
+        ),
+        (
+            "[[light]]\nkind = \"directional\"\ndirection = [0, 1, 0]\nirradiance = 1\npower = 3\n",
+            5,
+            9,
+            &[
+                "`power` is not a key of kind = \"directional\" lights",
+                "direction, irradiance",
+            ],
+        ),
+        (
+            "[[light]]\nkind = \"spot\"\nposition = [0, 0, 0]\npower = 3\n",
+            1,
+            1,
+            &[
+                "missing key `direction`",
+                "kind = \"spot\"",
+                "direction = [x, y, z]",
+            ],
+        ),
+        (
+            "[[light]]\nkind = \"directional\"\nirradiance = 1\ndirection = [0, 0, 0]\n",
+            4,
+            13,
+            &["the light direction is [0, 0, 0]", "not zero"],
+        ),
+        (
+            "[[light]]\nkind = \"spot\"\nposition = [0, 0, 0]\ndirection = [0, 1, 0]\npower = 3\ninner_angle = 30\nouter_angle = 20\n",
+            6,
+            15,
+            &["inner_angle 30 is wider than its outer_angle 20"],
+        ),
+        (
+            "[[light]]\nkind = \"spot\"\nposition = [0, 0, 0]\ndirection = [0, 1, 0]\npower = 3\nouter_angle = 95\n",
+            6,
+            15,
+            &["outer_angle (degrees) is 95", "from 0 to 90"],
+        ),
+        (
+            "[[light]]\nkind = \"environment\"\nemission = [0.1, -1, 0]\n",
+            3,
+            12,
+            &["environment emission -1 is not allowed"],
+        ),
+    ];
+    for (light, line, col, words) in cases {
+        let err = fails(
+            &d,
+            &format!(
+                "{light}\n[material.white]\ncolour = [1, 1, 1]\n[[object]]\nkind = \"box\"\nmaterial = \"white\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\n"
+            ),
+        );
+        says(&err, &file, line, col, words);
+    }
+}

@@ -197,3 +197,18 @@ fn a_camera_in_a_file_is_the_same_camera_as_on_the_command_line() {
     assert_eq!(from_file, from_flag, "the two cameras differ");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_sky_and_spots_files_load_with_their_lights() {
+    let load = |name: &str| {
+        let path = format!("{}/scenes/{name}", env!("CARGO_MANIFEST_DIR"));
+        file::load(std::path::Path::new(&path)).unwrap()
+    };
+    let sky = load("sky.toml");
+    assert_eq!(sky.directional_lights().len(), 1);
+    assert_eq!(sky.environment(), glam::Vec3::new(0.25, 0.3, 0.4));
+    let spots = load("spots.toml");
+    assert_eq!((spots.spot_lights().len(), spots.lights().len()), (2, 1));
+    let s = stats(&spots, spots.lights());
+    assert_eq!(s.effect_names(), ["spot lights"]);
+}

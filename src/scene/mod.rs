@@ -1,6 +1,7 @@
-//! A scene: triangles with materials, point lights, a starting camera and the effects it calls
-//! for. A scene that was built is valid: every triangle has a finite unit normal, every light a
-//! finite position and non-negative power, so rendering it cannot fail.
+//! A scene: triangles with materials, lights (point, directional, spot, a constant environment,
+//! emitting triangles), a starting camera and the effects it calls for. A scene that was built
+//! is valid: every triangle has a finite unit normal, every light a finite position, a unit
+//! direction and non-negative power, so rendering it cannot fail.
 
 pub mod builtin;
 pub mod cornell;
@@ -11,6 +12,8 @@ pub mod procedural;
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
+
+use std::f32::consts::FRAC_PI_2;
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -103,6 +106,53 @@ pub struct PointLight {
     pub power: Vec3,
 }
 
+/// A directional light: parallel light from far away (the sun), travelling along `direction`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectionalLight {
+    /// The way the light travels (unit length once built): a surface facing `-direction`
+    /// receives all of it.
+    pub direction: Vec3,
+    /// Irradiance per channel on a surface facing the light, in the seed's units: a white
+    /// diffuse surface facing it shows this value (glTF's lux).
+    pub irradiance: Vec3,
+}
+
+/// A spot light: a point light seen only within a cone around `direction`, fading from full
+/// within `inner` of the axis to nothing at `outer` by glTF's recommended falloff (see
+/// [`SpotLight::falloff`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpotLight {
+    /// Where the light is.
+    pub position: Vec3,
+    /// The cone's axis, where the light points (unit length once built).
+    pub direction: Vec3,
+    /// Per channel, the power of the point light it is cut from: along its axis it lights as a
+    /// [`PointLight`] of this power would (intensity `power/4π`, glTF's candela × 4π).
+    pub power: Vec3,
+    /// The angle from the axis (radians) within which the light is full.
+    pub inner: f32,
+    /// The angle from the axis (radians) beyond which there is none; `inner ≤ outer ≤ π/2`.
+    pub outer: f32,
+}
+
+impl SpotLight {
+    /// The cone's two cosines and the falloff's scale: `(cos outer, scale)` with the falloff
+    /// `t²`, `t = clamp((cos θ − cos outer)·scale, 0, 1)`, `scale = 1/(cos inner − cos
+    /// outer)` (glTF `KHR_lights_punctual`'s recommended smooth falloff, square of a ramp linear
+    /// in the cosine). Equal angles give a hard edge (the scale as large as an `f32` goes).
+    pub fn cone(&self) -> (f32, f32) {
+        let (ci, co) = (libm::cosf(self.inner), libm::cosf(self.outer));
+        (co, 1.0 / (ci - co).max(f32::MIN_POSITIVE))
+    }
+
+    /// The falloff toward a direction at `cos_theta` from the axis, in `[0, 1]`.
+    pub fn falloff(&self, cos_theta: f32) -> f32 {
+        let (co, scale) = self.cone();
+        let t = ((cos_theta - co) * scale).clamp(0.0, 1.0);
+        t * t
+    }
+}
+
 /// How indirect light is computed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Indirect {
@@ -153,6 +203,9 @@ pub struct Scene {
     triangles: Vec<Triangle>,
     materials: Vec<Material>,
     lights: Vec<PointLight>,
+    directional: Vec<DirectionalLight>,
+    spots: Vec<SpotLight>,
+    environment: Vec3,
     camera: Camera,
     effects: Effects,
     extent: f32,
@@ -193,6 +246,13 @@ pub enum SceneError {
         /// Index of the light.
         index: usize,
     },
+    /// A directional or spot light or the environment has a bad value.
+    LightOfKind {
+        /// "directional", "spot" or "environment".
+        kind: &'static str,
+        /// Index of the light among its kind.
+        index: usize,
+    },
 }
 
 impl std::fmt::Display for SceneError {
@@ -207,6 +267,10 @@ impl std::fmt::Display for SceneError {
             SceneError::Light { index } => write!(
                 f,
                 "light {index}: position must be finite and power finite and non-negative"
+            ),
+            SceneError::LightOfKind { kind, index } => write!(
+                f,
+                "{kind} light {index}: positions must be finite, directions finite and not zero, power finite and non-negative, angles 0 <= inner <= outer <= 90 degrees"
             ),
         }
     }
@@ -224,6 +288,9 @@ pub struct SceneBuilder {
     objects: Vec<Range<usize>>,
     materials: Vec<Material>,
     lights: Vec<PointLight>,
+    directional: Vec<DirectionalLight>,
+    spots: Vec<SpotLight>,
+    environment: Vec3,
     accel: Option<AccelKind>,
     drop_degenerate: bool,
     default_lights: bool,
@@ -292,6 +359,23 @@ impl SceneBuilder {
     /// Adds a light.
     pub fn light(&mut self, l: PointLight) {
         self.lights.push(l);
+    }
+
+    /// Adds a directional light.
+    pub fn directional_light(&mut self, l: DirectionalLight) {
+        self.directional.push(l);
+    }
+
+    /// Adds a spot light.
+    pub fn spot_light(&mut self, l: SpotLight) {
+        self.spots.push(l);
+    }
+
+    /// Adds a constant environment: what a ray that leaves the scene sees, per channel, in the
+    /// image's units (a camera sees it as that pixel value; a white diffuse surface open to
+    /// all of it shows the same). Environments add.
+    pub fn environment(&mut self, emission: Vec3) {
+        self.environment += emission;
     }
 
     /// Forces the acceleration structure (by default the faster one for the triangle count,
@@ -368,6 +452,36 @@ impl SceneBuilder {
         }) {
             return Err(SceneError::Light { index });
         }
+        let power_ok = |p: Vec3| p.is_finite() && p.min_element() >= 0.0;
+        let unit = |d: Vec3| d.is_finite() && d.length_squared() > 0.0;
+        let mut directional = self.directional;
+        for (index, l) in directional.iter_mut().enumerate() {
+            if !unit(l.direction) || !power_ok(l.irradiance) || !unit(l.direction.normalize()) {
+                let kind = "directional";
+                return Err(SceneError::LightOfKind { kind, index });
+            }
+            l.direction = l.direction.normalize();
+        }
+        let mut spots = self.spots;
+        for (index, l) in spots.iter_mut().enumerate() {
+            let angles = 0.0 <= l.inner && l.inner <= l.outer && l.outer <= FRAC_PI_2;
+            if !l.position.is_finite()
+                || !unit(l.direction)
+                || !unit(l.direction.normalize())
+                || !power_ok(l.power)
+                || !angles
+            {
+                return Err(SceneError::LightOfKind {
+                    kind: "spot",
+                    index,
+                });
+            }
+            l.direction = l.direction.normalize();
+        }
+        if !power_ok(self.environment) {
+            let kind = "environment";
+            return Err(SceneError::LightOfKind { kind, index: 0 });
+        }
         // The union of boxes is exact (min and max), so any order gives the same bounds.
         let bounds = if small {
             triangles
@@ -403,6 +517,9 @@ impl SceneBuilder {
             triangles,
             materials: self.materials,
             lights: self.lights,
+            directional,
+            spots,
+            environment: self.environment,
             camera,
             effects,
             extent: if extent.is_finite() && extent > 0.0 {
@@ -455,6 +572,21 @@ impl Scene {
     /// The lights the scene starts with (finite positions, non-negative power).
     pub fn lights(&self) -> &[PointLight] {
         &self.lights
+    }
+
+    /// The directional lights (unit directions, non-negative irradiance).
+    pub fn directional_lights(&self) -> &[DirectionalLight] {
+        &self.directional
+    }
+
+    /// The spot lights (unit directions, non-negative power, `0 ≤ inner ≤ outer ≤ π/2`).
+    pub fn spot_lights(&self) -> &[SpotLight] {
+        &self.spots
+    }
+
+    /// The constant environment: what a ray that leaves the scene sees (zero: none).
+    pub fn environment(&self) -> Vec3 {
+        self.environment
     }
 
     /// How far the app's keys move the camera and light, as a multiple of the Cornell box's

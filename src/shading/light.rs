@@ -1,6 +1,8 @@
-//! What a light gives a surface: one function per kind of light. The point light's is
-//! written once over [`Lanes`] (the tile kernel's), so that one ray at a time is width 1; the
-//! area light's (emitting triangles, path-traced frames only) is one point at a time.
+//! What a light gives a surface: one function per kind of light. The delta lights' (point,
+//! directional, spot: exact, one shadow ray each) are written once over [`Lanes`] (the tile
+//! kernel's), so that one ray at a time is width 1; the area light's (emitting triangles,
+//! path-traced frames only) is one point at a time. The constant environment is no function
+//! here: it is what a ray that leaves the scene brings back (see [`super::Tracer`]).
 
 use std::f32::consts::PI;
 
@@ -10,7 +12,34 @@ use super::lane::{Lanes, Scalar, each3};
 use super::surface::{Surface, dot, offset_origin};
 use crate::geometry::Ray;
 use crate::light::{AreaLights, area_to_solid_angle};
-use crate::scene::{PointLight, Scene};
+use crate::scene::{DirectionalLight, PointLight, Scene, SpotLight};
+
+/// The kinds of light a frame ran besides point lights and emitting triangles (for `render
+/// --stats`): each only where the scene has one that gives light and the frame shades.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LightEffects {
+    /// Directional lights (one shadow ray each per shaded point they face).
+    pub directional: bool,
+    /// Spot lights (one shadow ray each per shaded point within their cone).
+    pub spot: bool,
+    /// A constant environment (seen by rays that leave the scene; unshadowed in frames that
+    /// trace no random ray).
+    pub environment: bool,
+}
+
+impl LightEffects {
+    /// The names, in order: "directional lights", "spot lights", "environment".
+    pub fn names(&self) -> Vec<&'static str> {
+        [
+            (self.directional, "directional lights"),
+            (self.spot, "spot lights"),
+            (self.environment, "environment"),
+        ]
+        .into_iter()
+        .filter_map(|(on, name)| on.then_some(name))
+        .collect()
+    }
+}
 
 /// A point drawn on the area lights, as seen from a shaded point.
 pub(crate) struct AreaIncident {
@@ -133,6 +162,97 @@ pub(crate) fn point_light<S: Lanes>(
         lit: lit_bits,
         traced: s.bits(s.and(nonzero, finite)),
     }
+}
+
+/// An [`Incident`] that adds nothing and traces nothing.
+#[inline(always)]
+fn unlit<S: Lanes>(s: S) -> Incident<S::F> {
+    let zero = s.splat(0.0);
+    Incident {
+        term: [zero; 3],
+        origin: [zero; 3],
+        dir: [zero; 3],
+        lit: 0,
+        traced: 0,
+    }
+}
+
+/// A directional light at the points of `at`: irradiance `E·max(n̂·l̂, 0)` with `l̂ =
+/// −direction` toward the light, and where `shadows` the shadow ray toward it, `reach` long
+/// (longer than any segment within the scene's box, so that `t < 1 − ε` covers the scene). The
+/// irradiance is not zero (a dark light is skipped before).
+#[inline(always)]
+pub(crate) fn directional_light<S: Lanes>(
+    s: S,
+    light: &DirectionalLight,
+    reach: f32,
+    at: &Surface<S::F>,
+    shadows: bool,
+) -> Incident<S::F> {
+    let zero = s.splat(0.0);
+    let l = (-light.direction).to_array();
+    let toward = each3!(|k| s.splat(l[k]));
+    let cos = dot(s, at.normal, toward);
+    let lit = s.bits(s.gt(cos, zero));
+    if lit == 0 {
+        return unlit(s);
+    }
+    let e = light.irradiance.to_array();
+    let term = each3!(|k| s.mul(s.splat(e[k]), cos));
+    if !shadows {
+        return Incident {
+            term,
+            lit,
+            traced: 0,
+            ..unlit(s)
+        };
+    }
+    Incident {
+        term,
+        origin: offset_origin(s, at, toward),
+        dir: each3!(|k| s.splat(l[k] * reach)),
+        lit,
+        traced: lit,
+    }
+}
+
+/// A spot light at the points of `at`: the [`point_light`] it is cut from, times its cone's
+/// falloff ([`SpotLight::falloff`]) toward each point; points outside the cone are not lit
+/// and cost no shadow ray.
+#[inline(always)]
+pub(crate) fn spot_light<S: Lanes>(
+    s: S,
+    light: &SpotLight,
+    min_r2: f32,
+    at: &Surface<S::F>,
+    shadows: bool,
+) -> Incident<S::F> {
+    let point = PointLight {
+        position: light.position,
+        power: light.power,
+    };
+    let mut inc = point_light(s, &point, min_r2, at, shadows);
+    if inc.lit == 0 {
+        return inc;
+    }
+    // The cosine between the axis and the way from the light to each point.
+    let zero = s.splat(0.0);
+    let lp = light.position.to_array();
+    let from = each3!(|k| s.sub(at.p[k], s.splat(lp[k])));
+    let axis = light.direction.to_array();
+    let axis = each3!(|k| s.splat(axis[k]));
+    let cos = s.div(dot(s, axis, from), s.sqrt(dot(s, from, from)));
+    let (co, scale) = light.cone();
+    let t = s.min(
+        s.max(s.mul(s.sub(cos, s.splat(co)), s.splat(scale)), zero),
+        s.splat(1.0),
+    );
+    let falloff = s.mul(t, t);
+    let inside = s.bits(s.gt(falloff, zero));
+    inc.term = each3!(|k| s.mul(inc.term[k], falloff));
+    inc.lit &= inside;
+    inc.traced &= inside;
+    inc
 }
 
 #[cfg(test)]

@@ -25,6 +25,7 @@ mod tile;
 use lane::{Lanes, Scalar};
 use surface::{Surface, offset_origin, surface};
 
+pub use light::LightEffects;
 pub use path::{Estimator, PathEffects, PathRun};
 pub use split::{GuideHit, SplitSample};
 pub use stage::{Mode, RayCounts, Settings, Stage};
@@ -63,6 +64,16 @@ pub struct Tracer<'a> {
     path_effects: PathEffects,
     /// The estimator the frame's settings resolve to for this scene.
     estimator: Estimator,
+    /// How long a directional light's shadow ray is: longer than any segment within the
+    /// scene's box (twice its diagonal), so that it covers the scene from any point on it.
+    reach: f32,
+    /// The environment added to every point's direct light, unshadowed: the scene's, in
+    /// frames that trace no random ray (else zero: path-traced frames find it where their
+    /// rays leave the scene).
+    ambient: Vec3,
+    /// What a ray that leaves the scene brings back in a colour frame: the scene's
+    /// environment (zero in other frames).
+    background: Vec3,
     /// Per light, the shadow cull of a small scene's tiles, built on first use.
     #[cfg(target_arch = "x86_64")]
     culls: std::sync::OnceLock<Vec<crate::accel::shadow::ShadowCull>>,
@@ -73,6 +84,8 @@ impl<'a> Tracer<'a> {
     pub fn new(scene: &'a Scene, lights: &'a [PointLight], settings: Settings) -> Tracer<'a> {
         let r = scene.min_light_distance();
         let path_effects = PathEffects::of(scene);
+        let traced = matches!(settings.effects.indirect, Indirect::PathTraced { .. });
+        let colour = settings.mode == Mode::Colour;
         Tracer {
             scene,
             lights,
@@ -80,6 +93,16 @@ impl<'a> Tracer<'a> {
             min_r2: r * r,
             path_effects,
             estimator: path_effects.estimator(settings.estimator),
+            reach: 2.0 * scene.extent(),
+            ambient: match (settings.mode, traced) {
+                (Mode::Flat, _) | (_, true) => Vec3::ZERO,
+                _ => scene.environment(),
+            },
+            background: if colour {
+                scene.environment()
+            } else {
+                Vec3::ZERO
+            },
             #[cfg(target_arch = "x86_64")]
             culls: std::sync::OnceLock::new(),
         }
@@ -93,7 +116,9 @@ impl<'a> Tracer<'a> {
         rng: &mut impl SampleSource,
         n: &mut RayCounts,
     ) -> Vec3 {
-        let Some(hit) = hit else { return Vec3::ZERO };
+        let Some(hit) = hit else {
+            return self.background;
+        };
         let c = if self.physical() {
             self.path(ray, &hit, rng, n)
         } else {
@@ -101,6 +126,21 @@ impl<'a> Tracer<'a> {
         };
         debug_assert!(c.is_finite(), "non-finite colour {c}");
         c
+    }
+
+    /// The kinds of light besides points and emitters that this frame shades with.
+    pub fn light_effects(&self) -> LightEffects {
+        let shading = self.settings.mode != Mode::Flat;
+        let scene = self.scene;
+        LightEffects {
+            directional: shading
+                && scene
+                    .directional_lights()
+                    .iter()
+                    .any(|l| l.irradiance != Vec3::ZERO),
+            spot: shading && scene.spot_lights().iter().any(|l| l.power != Vec3::ZERO),
+            environment: self.ambient != Vec3::ZERO || self.background != Vec3::ZERO,
+        }
     }
 
     /// Whether this frame's indirect light is path traced, so that [`Tracer::sample_primary`]
@@ -127,7 +167,10 @@ impl<'a> Tracer<'a> {
         n: &mut RayCounts,
     ) -> SplitSample {
         let Some(hit) = hit else {
-            return SplitSample::default();
+            return SplitSample {
+                rest: self.background,
+                ..SplitSample::default()
+            };
         };
         let s = self.split(ray, &hit, 0, rng, n);
         debug_assert!(s.colour().is_finite(), "non-finite colour {}", s.colour());
@@ -195,7 +238,10 @@ impl<'a> Tracer<'a> {
         n.reflection += 1;
         let reflected = match self.scene.intersect(&reflected_ray, f32::INFINITY) {
             Some(h) => self.split(&reflected_ray, &h, mirror_depth + 1, rng, n),
-            None => SplitSample::default(),
+            None => SplitSample {
+                rest: self.background,
+                ..SplitSample::default()
+            },
         };
         // The pixel is filtered on whichever surface weighs more in it; the other one's
         // indirect light stays in `rest`, unfiltered.
@@ -227,7 +273,7 @@ impl<'a> Tracer<'a> {
     ) -> Vec3 {
         match self.scene.intersect(ray, f32::INFINITY) {
             Some(hit) => self.shade(ray, &hit, mirror_depth, bounce, rng, n),
-            None => Vec3::ZERO,
+            None => self.background,
         }
     }
 

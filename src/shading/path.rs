@@ -18,7 +18,7 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use super::lane::Scalar;
-use super::light::{AreaIncident, area_light, point_light};
+use super::light::{AreaIncident, area_light, directional_light, point_light, spot_light};
 use super::surface::offset_origin;
 use super::{MIN_SURVIVAL, Mode, ROULETTE_START, RayCounts, SHADOW_EPSILON, Tracer, surface_of};
 use crate::accel::Hit;
@@ -273,6 +273,41 @@ impl Tracer<'_> {
                     }
                     colour += beta * f * Vec3::from_array(inc.term) * PI;
                 }
+                // Directional and spot lights: exact, as the point lights.
+                let directional = scene
+                    .directional_lights()
+                    .iter()
+                    .filter(|l| l.irradiance != Vec3::ZERO)
+                    .map(|l| {
+                        let inc = directional_light(Scalar, l, self.reach, &at, true);
+                        (-l.direction, inc)
+                    });
+                let spots = scene
+                    .spot_lights()
+                    .iter()
+                    .filter(|l| l.power != Vec3::ZERO)
+                    .map(|l| {
+                        let inc = spot_light(Scalar, l, self.min_r2, &at, true);
+                        ((l.position - p).normalize(), inc)
+                    });
+                for (wi, inc) in directional.chain(spots) {
+                    if inc.lit == 0 {
+                        continue;
+                    }
+                    let f = bsdf.f(wo, frame.to_local(wi));
+                    if f == Vec3::ZERO {
+                        continue;
+                    }
+                    if inc.traced != 0 {
+                        n.shadow += 1;
+                        let shadow =
+                            Ray::new(Vec3::from_array(inc.origin), Vec3::from_array(inc.dir));
+                        if scene.occluded(&shadow, 1.0 - SHADOW_EPSILON) {
+                            continue;
+                        }
+                    }
+                    colour += beta * f * Vec3::from_array(inc.term) * PI;
+                }
                 if mis != Estimator::Bsdf
                     && let Some(lights) = scene.area_lights()
                     && let Some(AreaIncident {
@@ -342,7 +377,13 @@ impl Tracer<'_> {
             };
             match scene.intersect(&ray, f32::INFINITY) {
                 Some(h) => hit = h,
-                None => break,
+                None => {
+                    // The environment, found by BSDF sampling alone (counted whole): under a
+                    // constant sky the BSDF's own sampling draws `f·cos` as well as any light
+                    // sampling could, and costs no shadow ray.
+                    colour += beta * self.background;
+                    break;
+                }
             }
         }
         debug_assert!(colour.is_finite(), "non-finite colour {colour}");

@@ -10,13 +10,13 @@
 use glam::Vec3;
 
 use super::lane::{Lanes, Scalar, each3};
-use super::light::point_light;
+use super::light::{directional_light, point_light, spot_light};
 use super::surface::{Surface, surface};
 use super::{Mode, RayCounts, SHADOW_EPSILON, Tracer};
 use crate::accel::TILE_RAYS;
 use crate::accel::tri4::Best8;
 use crate::geometry::{Ray, RayTile};
-use crate::scene::Indirect;
+use crate::scene::{DirectionalLight, Indirect, PointLight, SpotLight};
 
 /// Most pixels in a tile.
 const N: usize = TILE_RAYS;
@@ -122,6 +122,14 @@ enum Shadows {
     /// In packets of eight against the light's cull ([`Tracer::culls`]: small scenes).
     #[cfg(target_arch = "x86_64")]
     Packets(super::lane::Avx2),
+}
+
+/// A light that [`Tracer::add_light`] adds exactly, with one shadow ray per point.
+#[derive(Clone, Copy)]
+enum Delta<'a> {
+    Point(&'a PointLight),
+    Directional(&'a DirectionalLight),
+    Spot(&'a SpotLight),
 }
 
 /// Scratch space of [`Shadows::Scene`] for a tile.
@@ -246,7 +254,7 @@ impl Tracer<'_> {
             for l in 0..lanes {
                 let i = 8 * c + l;
                 if ids[l] == u32::MAX {
-                    out[i] = Vec3::ZERO;
+                    out[i] = self.background;
                 } else if own >> l & 1 == 0 {
                     others |= 1 << i;
                 } else {
@@ -417,8 +425,6 @@ impl Tracer<'_> {
     ) {
         let w = S::WIDTH;
         let chunks = m.div_ceil(w);
-        // The lanes of block `c` that hold a pixel.
-        let valid = |c: usize| (1u32 << (m - c * w).min(w)) - 1;
         for sum in &mut pts.sum[..m.div_ceil(8)] {
             *sum = [[0.0; 8]; 3];
         }
@@ -427,53 +433,111 @@ impl Tracer<'_> {
             if light.power == Vec3::ZERO {
                 continue;
             }
-            let (mut lit, mut traced) = (0u64, 0u64);
-            for c in 0..chunks {
-                let o = c * w;
-                let at = pts.surface(s, o);
-                let inc = point_light(s, light, self.min_r2, &at, self.settings.effects.shadows);
-                let (bi, ai) = (o / 8, o % 8);
-                let (term, origin, dir) =
-                    (&mut pts.term[bi], &mut pts.origin[bi], &mut pts.dir[bi]);
-                each3!(|a| {
-                    s.store_at(&mut term[a], ai, inc.term[a]);
-                    s.store_at(&mut origin[a], ai, inc.origin[a]);
-                    s.store_at(&mut dir[a], ai, inc.dir[a]);
-                });
-                let on = inc.lit & valid(c);
-                lit |= (on as u64) << (c * w);
-                traced |= ((inc.traced & on) as u64) << (c * w);
+            self.add_light(s, pts, m, Delta::Point(light), shadows, li, scratch, n);
+        }
+        // The other delta lights: no shadow cull of their own, so their rays go through the
+        // scene's structure.
+        for light in self.scene.directional_lights() {
+            if light.irradiance == Vec3::ZERO {
+                continue;
             }
-            let mut blocked = 0;
-            if self.settings.effects.shadows && traced != 0 {
-                n.shadow += traced.count_ones() as u64;
-                let t_max = 1.0 - SHADOW_EPSILON;
-                blocked = match shadows {
-                    Shadows::Scene => self.blocked(pts, traced, t_max, scratch),
-                    #[cfg(target_arch = "x86_64")]
-                    Shadows::Packets(avx2) => {
-                        let cull = &self.culls().expect("a small scene's culls")[li];
-                        super::packets::blocked(avx2, cull, pts, m, traced, t_max)
-                    }
-                };
+            let light = Delta::Directional(light);
+            self.add_light(s, pts, m, light, Shadows::Scene, 0, scratch, n);
+        }
+        for light in self.scene.spot_lights() {
+            if light.power == Vec3::ZERO {
+                continue;
             }
-            #[cfg(not(target_arch = "x86_64"))]
-            let _ = li;
-            let add = lit & !blocked;
+            let light = Delta::Spot(light);
+            self.add_light(s, pts, m, light, Shadows::Scene, 0, scratch, n);
+        }
+        // Frames that trace no random ray take the environment unshadowed, as the seed's
+        // constant N (path-traced ones find it where their rays leave the scene).
+        if self.ambient != Vec3::ZERO {
+            let e = self.ambient.to_array();
             for c in 0..chunks {
-                let on = (add >> (c * w)) as u32 & valid(c);
-                if on == 0 {
-                    continue;
-                }
-                let on = s.lanes(on);
                 let (bi, ai) = (c * w / 8, c * w % 8);
-                let (sum, term) = (&mut pts.sum[bi], &pts.term[bi]);
+                let sum = &mut pts.sum[bi];
                 each3!(|a| {
                     let v = s.load_at(&sum[a], ai);
-                    let t = s.load_at(&term[a], ai);
-                    s.store_at(&mut sum[a], ai, s.select(on, s.add(v, t), v));
+                    s.store_at(&mut sum[a], ai, s.add(v, s.splat(e[a])));
                 });
             }
+        }
+    }
+
+    /// Adds one delta light to the sums of [`Tracer::add_lights`]: its [`Incident`] at each
+    /// block of points, the shadow rays of the points it reaches traced together (as `shadows`
+    /// says; light `li`'s cull for packets), and its term where nothing blocks.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn add_light<S: Lanes, const B: usize>(
+        &self,
+        s: S,
+        pts: &mut Points<B>,
+        m: usize,
+        light: Delta,
+        shadows: Shadows,
+        li: usize,
+        scratch: &mut ShadowScratch,
+        n: &mut RayCounts,
+    ) {
+        let w = S::WIDTH;
+        let chunks = m.div_ceil(w);
+        // The lanes of block `c` that hold a pixel.
+        let valid = |c: usize| (1u32 << (m - c * w).min(w)) - 1;
+        let (mut lit, mut traced) = (0u64, 0u64);
+        for c in 0..chunks {
+            let o = c * w;
+            let at = pts.surface(s, o);
+            // (A match, not a closure: a closure would not be compiled with the kernel's
+            // target features, and the lane functions would not inline into it.)
+            let shadows_on = self.settings.effects.shadows;
+            let inc = match light {
+                Delta::Point(l) => point_light(s, l, self.min_r2, &at, shadows_on),
+                Delta::Directional(l) => directional_light(s, l, self.reach, &at, shadows_on),
+                Delta::Spot(l) => spot_light(s, l, self.min_r2, &at, shadows_on),
+            };
+            let (bi, ai) = (o / 8, o % 8);
+            let (term, origin, dir) = (&mut pts.term[bi], &mut pts.origin[bi], &mut pts.dir[bi]);
+            each3!(|a| {
+                s.store_at(&mut term[a], ai, inc.term[a]);
+                s.store_at(&mut origin[a], ai, inc.origin[a]);
+                s.store_at(&mut dir[a], ai, inc.dir[a]);
+            });
+            let on = inc.lit & valid(c);
+            lit |= (on as u64) << (c * w);
+            traced |= ((inc.traced & on) as u64) << (c * w);
+        }
+        let mut blocked = 0;
+        if self.settings.effects.shadows && traced != 0 {
+            n.shadow += traced.count_ones() as u64;
+            let t_max = 1.0 - SHADOW_EPSILON;
+            blocked = match shadows {
+                Shadows::Scene => self.blocked(pts, traced, t_max, scratch),
+                #[cfg(target_arch = "x86_64")]
+                Shadows::Packets(avx2) => {
+                    let cull = &self.culls().expect("a small scene's culls")[li];
+                    super::packets::blocked(avx2, cull, pts, m, traced, t_max)
+                }
+            };
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = li;
+        let add = lit & !blocked;
+        for c in 0..chunks {
+            let on = (add >> (c * w)) as u32 & valid(c);
+            if on == 0 {
+                continue;
+            }
+            let on = s.lanes(on);
+            let (bi, ai) = (c * w / 8, c * w % 8);
+            let (sum, term) = (&mut pts.sum[bi], &pts.term[bi]);
+            each3!(|a| {
+                let v = s.load_at(&sum[a], ai);
+                let t = s.load_at(&term[a], ai);
+                s.store_at(&mut sum[a], ai, s.select(on, s.add(v, t), v));
+            });
         }
     }
 

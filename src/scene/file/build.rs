@@ -6,17 +6,19 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
-use super::check::{Ctx, toml_error};
+use super::check::{Ctx, KEY_FORMS, toml_error};
 use super::error::{SceneFileError, did_you_mean};
 use super::objects::object_triangles;
 use super::spec::{
     CameraSpec, EffectsSpec, INDIRECT_EXPECTED, IndirectSpec, LightSpec, MaterialSpec,
-    NumberOrTriple, SceneSpec,
+    NumberOrTriple, SceneSpec, Three,
 };
 use super::*;
 use crate::camera::Camera;
 use crate::sampler::Sampler;
-use crate::scene::{Effects, Indirect, MAX_IOR, Material, PointLight, SceneBuilder};
+use crate::scene::{
+    DirectionalLight, Effects, Indirect, MAX_IOR, Material, PointLight, SceneBuilder, SpotLight,
+};
 use toml::Spanned;
 
 /// Parses `source` and builds its scene.
@@ -40,7 +42,13 @@ pub fn build(
     }
 
     let mut b = SceneBuilder::new();
-    lights.into_iter().for_each(|l| b.light(l));
+    lights.point.into_iter().for_each(|l| b.light(l));
+    lights
+        .directional
+        .into_iter()
+        .for_each(|l| b.directional_light(l));
+    lights.spot.into_iter().for_each(|l| b.spot_light(l));
+    b.environment(lights.environment);
     let mut material_names: Vec<&str> = materials.keys().copied().collect();
     material_names.sort_unstable();
     // Materials enter the scene in the order objects first use them.
@@ -98,28 +106,188 @@ fn camera(cx: &Ctx, spec: Option<&CameraSpec>) -> Result<Camera, SceneFileError>
     Ok(camera)
 }
 
-/// `[[light]]`: at most [`MAX_LIGHTS`], each power from 0 to [`MAX_POWER`] per channel.
-fn lights(cx: &Ctx, specs: &[Spanned<LightSpec>]) -> Result<Vec<PointLight>, SceneFileError> {
-    let mut out = Vec::with_capacity(specs.len());
-    for (i, l) in specs.iter().enumerate() {
+/// The lights of a file, by kind.
+#[derive(Default)]
+struct Lights {
+    point: Vec<PointLight>,
+    directional: Vec<DirectionalLight>,
+    spot: Vec<SpotLight>,
+    environment: Vec3,
+}
+
+/// The light kinds, the keys each one needs and the ones it may have (besides `kind`).
+const LIGHT_KINDS: [(&str, &[&str], &[&str]); 4] = [
+    ("point", &["position", "power"], &[]),
+    ("directional", &["direction", "irradiance"], &[]),
+    (
+        "spot",
+        &["position", "direction", "power"],
+        &["inner_angle", "outer_angle"],
+    ),
+    ("environment", &["emission"], &[]),
+];
+
+/// A spot's cone when the file does not say (glTF's defaults): full on its axis, none past
+/// 45 degrees.
+const SPOT_ANGLES: (f64, f64) = (0.0, 45.0);
+
+/// `[[light]]`: at most [`MAX_LIGHTS`], each of a known kind with that kind's keys; powers and
+/// irradiances from 0 to [`MAX_POWER`], an environment's emission from 0 to [`MAX_EMISSION`]
+/// per channel; directions not zero; a spot's angles from 0 to 90 degrees, inner ≤ outer.
+fn lights(cx: &Ctx, specs: &[Spanned<LightSpec>]) -> Result<Lights, SceneFileError> {
+    let mut out = Lights::default();
+    for (i, spanned) in specs.iter().enumerate() {
         if i == MAX_LIGHTS {
-            return Err(cx.err_at(l, format!("too many lights: at most {MAX_LIGHTS}")));
+            return Err(cx.err_at(spanned, format!("too many lights: at most {MAX_LIGHTS}")));
         }
-        let l = l.get_ref();
-        let position = cx.point(&l.position, "the light position")?;
-        let NumberOrTriple(p) = *l.power.get_ref();
-        if let Some(bad) = p.iter().find(|c| !(**c >= 0.0 && **c <= MAX_POWER)) {
+        let l = spanned.get_ref();
+        let kind = l.kind.as_ref().map_or("point", |k| k.get_ref().as_str());
+        let kinds: Vec<&str> = LIGHT_KINDS.iter().map(|k| k.0).collect();
+        let Some(&(_, needs, may)) = LIGHT_KINDS.iter().find(|k| k.0 == kind) else {
+            let at = l.kind.as_ref().expect("the default kind is known");
             return Err(cx.err_at(
-                &l.power,
+                at,
                 format!(
-                    "light power {bad} is not allowed: expected a number from 0 to {MAX_POWER:e}, or [r, g, b] of such numbers (the Cornell box's is 14)"
+                    "unknown light kind `{kind}`{} (kinds: {})",
+                    did_you_mean(kind, &kinds),
+                    kinds.join(", ")
+                ),
+            ));
+        };
+        fn at<T>(v: &Option<Spanned<T>>) -> Option<usize> {
+            v.as_ref().map(|v| v.span().start)
+        }
+        let given = [
+            ("position", at(&l.position)),
+            ("power", at(&l.power)),
+            ("direction", at(&l.direction)),
+            ("irradiance", at(&l.irradiance)),
+            ("inner_angle", at(&l.inner_angle)),
+            ("outer_angle", at(&l.outer_angle)),
+            ("emission", at(&l.emission)),
+        ];
+        let takes = || {
+            let mut keys: Vec<&str> = vec!["kind"];
+            keys.extend(needs.iter().chain(may));
+            keys.join(", ")
+        };
+        for (key, offset) in given {
+            if let (Some(offset), false) = (offset, needs.contains(&key) || may.contains(&key)) {
+                return Err(cx.err(
+                    offset,
+                    format!(
+                        "`{key}` is not a key of kind = \"{kind}\" lights: they take {}",
+                        takes()
+                    ),
+                ));
+            }
+        }
+        if let Some((key, _)) = given
+            .iter()
+            .find(|(key, offset)| offset.is_none() && needs.contains(key))
+        {
+            let form = KEY_FORMS.iter().find(|k| k.0 == *key).map_or("", |k| k.1);
+            return Err(cx.err_at(
+                spanned,
+                format!(
+                    "missing key `{key}` in this kind = \"{kind}\" light: add {form} (they take {})",
+                    takes()
                 ),
             ));
         }
-        out.push(PointLight {
-            position,
-            power: Vec3::from(p.map(|c| c as f32)),
-        });
+        fn need(v: &Option<Spanned<Three<f64>>>) -> &Spanned<Three<f64>> {
+            v.as_ref().expect("checked above")
+        }
+        let amount = |v: &Option<Spanned<NumberOrTriple>>, what: &str, max: f64, example: &str| {
+            let v = v.as_ref().expect("checked above");
+            let NumberOrTriple(p) = *v.get_ref();
+            match p.iter().find(|c| !(**c >= 0.0 && **c <= max)) {
+                Some(bad) => Err(cx.err_at(
+                    v,
+                    format!(
+                        "{what} {bad} is not allowed: expected a number from 0 to {max:e}, or [r, g, b] of such numbers ({example})"
+                    ),
+                )),
+                None => Ok(Vec3::from(p.map(|c| c as f32))),
+            }
+        };
+        let direction = |what: &str| -> Result<Vec3, SceneFileError> {
+            let v = need(&l.direction);
+            let d = cx.point(v, what)?;
+            if d == Vec3::ZERO {
+                return Err(cx.err_at(
+                    v,
+                    format!("{what} is [0, 0, 0]: expected a direction, not zero"),
+                ));
+            }
+            Ok(d)
+        };
+        match kind {
+            "point" => out.point.push(PointLight {
+                position: cx.point(need(&l.position), "the light position")?,
+                power: amount(
+                    &l.power,
+                    "light power",
+                    MAX_POWER,
+                    "the Cornell box's is 14",
+                )?,
+            }),
+            "directional" => out.directional.push(DirectionalLight {
+                direction: direction("the light direction")?,
+                irradiance: amount(
+                    &l.irradiance,
+                    "light irradiance",
+                    MAX_POWER,
+                    "1 lights a white surface facing it as 1",
+                )?,
+            }),
+            "spot" => {
+                let angle = |v: &Option<Spanned<f64>>, default: f64, what: &str| {
+                    v.as_ref()
+                        .map_or(Ok(default), |v| cx.ranged(v, 0.0, 90.0, what))
+                };
+                let outer = angle(
+                    &l.outer_angle,
+                    SPOT_ANGLES.1,
+                    "the spot's outer_angle (degrees)",
+                )?;
+                let inner = angle(
+                    &l.inner_angle,
+                    SPOT_ANGLES.0,
+                    "the spot's inner_angle (degrees)",
+                )?;
+                if inner > outer {
+                    let at = l
+                        .inner_angle
+                        .as_ref()
+                        .map_or(spanned.span().start, |v| v.span().start);
+                    return Err(cx.err(
+                        at,
+                        format!("the spot's inner_angle {inner} is wider than its outer_angle {outer}: expected inner_angle <= outer_angle"),
+                    ));
+                }
+                out.spot.push(SpotLight {
+                    position: cx.point(need(&l.position), "the light position")?,
+                    direction: direction("the spot direction")?,
+                    power: amount(
+                        &l.power,
+                        "light power",
+                        MAX_POWER,
+                        "the Cornell box's is 14",
+                    )?,
+                    inner: (inner as f32).to_radians(),
+                    outer: (outer as f32).to_radians(),
+                });
+            }
+            _ => {
+                out.environment += amount(
+                    &l.emission,
+                    "environment emission",
+                    MAX_EMISSION,
+                    "a camera sees the sky as this value",
+                )?;
+            }
+        }
     }
     Ok(out)
 }

@@ -9,9 +9,15 @@ use super::spec::Three;
 use crate::scene::MAX_COORDINATE;
 
 /// How each required key is written, for "missing key" messages.
-const KEY_FORMS: [(&str, &str); 6] = [
+pub const KEY_FORMS: [(&str, &str); 9] = [
     ("position", "position = [x, y, z]"),
     ("power", "power = 14 (or [r, g, b])"),
+    (
+        "direction",
+        "direction = [x, y, z] (the way the light travels)",
+    ),
+    ("irradiance", "irradiance = 1 (or [r, g, b])"),
+    ("emission", "emission = 0.5 (or [r, g, b])"),
     ("colour", "colour = [r, g, b] (each from 0 to 1)"),
     (
         "kind",

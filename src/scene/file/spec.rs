@@ -33,12 +33,19 @@ pub struct CameraSpec {
     pub pitch: Option<Spanned<f64>>,
 }
 
-/// One `[[light]]`.
+/// One `[[light]]`: every kind's keys, checked against its `kind` (default "point") after
+/// parsing.
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 pub struct LightSpec {
-    pub position: Spanned<Three<f64>>,
-    pub power: Spanned<NumberOrTriple>,
+    pub kind: Option<Spanned<String>>,
+    pub position: Option<Spanned<Three<f64>>>,
+    pub power: Option<Spanned<NumberOrTriple>>,
+    pub direction: Option<Spanned<Three<f64>>>,
+    pub irradiance: Option<Spanned<NumberOrTriple>>,
+    pub inner_angle: Option<Spanned<f64>>,
+    pub outer_angle: Option<Spanned<f64>>,
+    pub emission: Option<Spanned<NumberOrTriple>>,
 }
 
 /// One `[material.NAME]`.

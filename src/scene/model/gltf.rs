@@ -3,7 +3,7 @@
 //! hierarchy with its transforms, triangle meshes (lists, strips and fans; indexed or not) with
 //! their normals, first UVs and `COLOR_0`, metallic-roughness materials (with the emissive
 //! strength, IOR and transmission extensions), perspective cameras and `KHR_lights_punctual`
-//! point lights (spot lights as point lights; directional lights are not drawn yet, and said).
+//! point, spot and directional lights.
 //!
 //! Accessors are read here, each range checked against its buffer first, so no file can make
 //! a read go out of bounds. A required extension raytty does not read is an error naming it.
@@ -15,7 +15,9 @@ use ::gltf::mesh::Mode;
 use ::gltf::{Gltf, Node, buffer};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
-use super::{FileReader, Model, ModelCamera, ModelLight, ModelMaterial, check_triangles};
+use super::{
+    FileReader, Model, ModelCamera, ModelLight, ModelLightKind, ModelMaterial, check_triangles,
+};
 use crate::scene::file::SceneFileError;
 
 /// The extensions a file may require: those read here, and those whose absence only loses
@@ -134,23 +136,42 @@ pub fn parse(bytes: &[u8], file: &str, read: FileReader) -> Result<Model, SceneF
             use ::gltf::khr_lights_punctual::Kind;
             let intensity = Vec3::from(light.color()) * light.intensity();
             let position = world.transform_point3(Vec3::ZERO);
-            match light.kind() {
-                Kind::Point => model.lights.push(ModelLight {
+            // Directional and spot lights point down their node's -z.
+            let direction = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+            let kind = match light.kind() {
+                Kind::Point => Some(ModelLightKind::Point),
+                _ if direction == Vec3::ZERO => None,
+                Kind::Directional => Some(ModelLightKind::Directional { direction }),
+                Kind::Spot {
+                    inner_cone_angle,
+                    outer_cone_angle,
+                } => {
+                    let ok = 0.0 <= inner_cone_angle
+                        && inner_cone_angle <= outer_cone_angle
+                        && outer_cone_angle <= std::f32::consts::FRAC_PI_2;
+                    if !ok {
+                        return Err(whole(format!(
+                            "/extensions/KHR_lights_punctual/lights/{}/spot: cone angles {inner_cone_angle} and {outer_cone_angle}: expected 0 <= innerConeAngle <= outerConeAngle <= pi/2",
+                            light.index()
+                        )));
+                    }
+                    Some(ModelLightKind::Spot {
+                        direction,
+                        inner: inner_cone_angle,
+                        outer: outer_cone_angle,
+                    })
+                }
+            };
+            match kind {
+                Some(kind) => model.lights.push(ModelLight {
                     position,
                     intensity,
+                    kind,
                 }),
-                Kind::Spot { .. } => {
-                    model.note(
-                        "spot lights are drawn as point lights (their cones are not used yet)",
-                    );
-                    model.lights.push(ModelLight {
-                        position,
-                        intensity,
-                    });
-                }
-                Kind::Directional => {
-                    model.note("directional lights are not drawn yet");
-                }
+                None => model.note(format!(
+                    "light {}: its node's transform is degenerate, so it has no direction; not used",
+                    light.index()
+                )),
             }
         }
         for c in node.children().collect::<Vec<_>>().into_iter().rev() {

@@ -26,7 +26,10 @@ use std::path::Path;
 use glam::{Vec2, Vec3};
 
 use crate::scene::file::{MAX_EMISSION, SceneFileError};
-use crate::scene::{Effects, MAX_COORDINATE, MAX_IOR, Material, PointLight, Scene, SceneBuilder};
+use crate::scene::{
+    DirectionalLight, Effects, MAX_COORDINATE, MAX_IOR, Material, PointLight, Scene, SceneBuilder,
+    SpotLight,
+};
 
 pub use progress::{LoadProgress, LoadStep};
 pub use view::{View, ViewError};
@@ -123,10 +126,35 @@ pub struct ModelCamera {
 /// A light a file places.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ModelLight {
-    /// Where it is.
+    /// Where it is (unused by a directional light).
     pub position: Vec3,
-    /// Radiant intensity per channel (W/sr; glTF's colour times intensity).
+    /// Radiant intensity per channel (W/sr; glTF's colour times intensity: candela), or a
+    /// directional light's irradiance (lux).
     pub intensity: Vec3,
+    /// What kind of light.
+    pub kind: ModelLightKind,
+}
+
+/// The kinds of a model's lights (glTF's `KHR_lights_punctual`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ModelLightKind {
+    /// Light in all directions.
+    Point,
+    /// Parallel light travelling along `direction`.
+    Directional {
+        /// The way the light travels.
+        direction: Vec3,
+    },
+    /// A point light within a cone around `direction`, full within `inner` radians of it,
+    /// none beyond `outer`.
+    Spot {
+        /// Where it points.
+        direction: Vec3,
+        /// The cone's angles (radians).
+        inner: f32,
+        /// See `inner`.
+        outer: f32,
+    },
 }
 
 /// A triangle mesh read from a file, before it becomes a [`Scene`].
@@ -221,16 +249,35 @@ impl Model {
                 materials[i.min(materials.len() - 1)],
             )
         }));
-        let mut lights: Vec<PointLight> = self
-            .lights
-            .iter()
-            .take(MAX_MODEL_LIGHTS)
-            .map(|l| PointLight {
-                position: l.position,
-                // A point light of radiant intensity I emits 4π·I.
-                power: l.intensity * (4.0 * std::f32::consts::PI),
-            })
-            .collect();
+        // A point light of radiant intensity I emits 4π·I; a spot is the point light it is
+        // cut from.
+        let mut lights: Vec<PointLight> = Vec::new();
+        for l in self.lights.iter().take(MAX_MODEL_LIGHTS) {
+            let power = l.intensity * (4.0 * std::f32::consts::PI);
+            match l.kind {
+                ModelLightKind::Point => lights.push(PointLight {
+                    position: l.position,
+                    power,
+                }),
+                ModelLightKind::Directional { direction } => {
+                    b.directional_light(DirectionalLight {
+                        direction,
+                        irradiance: l.intensity,
+                    })
+                }
+                ModelLightKind::Spot {
+                    direction,
+                    inner,
+                    outer,
+                } => b.spot_light(SpotLight {
+                    position: l.position,
+                    direction,
+                    power,
+                    inner,
+                    outer,
+                }),
+            }
+        }
         if self.lights.len() > MAX_MODEL_LIGHTS {
             self.note(format!(
                 "{} lights: the first {MAX_MODEL_LIGHTS} are used",
@@ -245,7 +292,7 @@ impl Model {
             .map(|m| scene_material(m, Vec3::ONE))
             .collect();
         let emits = used.iter().any(|m| m.emission != Vec3::ZERO);
-        let default_lights = lights.is_empty() && !emits;
+        let default_lights = self.lights.is_empty() && !emits;
         // Light from surfaces, metal and glass show only where light is path traced (as in the
         // built-in scenes that have them: 16 bounces); other models keep the seed's effects.
         let traced =
