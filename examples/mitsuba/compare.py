@@ -3,8 +3,8 @@
 
 An independent check of raytty's path tracer: the same triangles (exported by
 `cargo run --release --example mitsuba -- SCENE DIR`), the same camera, Mitsuba's `diffuse`
-BSDF (two-sided, as raytty shades both sides), point emitters, a `box` pixel filter and the
-`path` integrator. Prints both renderers' times and the RMSE and 10x10-block RMSE between
+BSDF (two-sided, as raytty shades both sides), point, directional, spot and constant
+emitters, a `box` pixel filter and the `path` integrator. Prints both renderers' times and the RMSE and 10x10-block RMSE between
 their images (block means: noise averages away in them, a systematic difference does not).
 
 Units. raytty's pixel is rho*E with the diffuse 1/pi dropped (the seed's lab: a point light of
@@ -153,7 +153,56 @@ def mitsuba_scene(mi, spec, export_dir, width, height, spp, max_depth):
             "position": light["position"],
             "intensity": {"type": "rgb", "value": [p / (4 * math.pi) for p in light["power"]]},
         }
+    # A directional light's irradiance is the same number in both (raytty's pixel is rho*E;
+    # Mitsuba's radiance rho*E/pi, times pi); both take the direction the light travels.
+    for i, light in enumerate(spec.get("directional", [])):
+        scene[f"sun{i}"] = {
+            "type": "directional",
+            "direction": light["direction"],
+            "irradiance": {"type": "rgb", "value": light["irradiance"]},
+        }
+    # A spot: the intensity on its axis is the power over 4 pi, as a point light's. Mitsuba's
+    # own falloff is linear in the angle; raytty's is glTF's (t^2, t linear in the cosine), so
+    # Mitsuba gets a hard cone at the outer angle times a texture of raytty's falloff
+    # (projected along the spot: u, v span tan(outer) either side of the axis).
+    for i, light in enumerate(spec.get("spots", [])):
+        pos, d = light["position"], light["direction"]
+        up = [0, 0, 1] if abs(d[2]) < 0.9 else [1, 0, 0]
+        spot = {
+            "type": "spot",
+            "to_world": mi.ScalarTransform4f().look_at(
+                origin=pos, target=[p + q for p, q in zip(pos, d)], up=up),
+            "intensity": {"type": "rgb", "value": [p / (4 * math.pi) for p in light["power"]]},
+            "cutoff_angle": math.degrees(light["outer"]),
+            "beam_width": math.degrees(light["outer"]),
+        }
+        if light["inner"] < light["outer"]:
+            spot["texture"] = {
+                "type": "bitmap",
+                "bitmap": mi.Bitmap(spot_falloff(light["inner"], light["outer"])),
+                "raw": True,
+                "filter_type": "bilinear",
+                "wrap_mode": "clamp",
+            }
+        scene[f"spot{i}"] = spot
+    # The environment: raytty's value is what the camera sees, pi times radiance.
+    env = spec.get("environment", [0, 0, 0])
+    if max(env) > 0:
+        scene["environment"] = {
+            "type": "constant",
+            "radiance": {"type": "rgb", "value": [e / math.pi for e in env]},
+        }
     return scene
+
+
+def spot_falloff(inner, outer, n=1024):
+    """raytty's spot falloff as an n x n RGB image over the plane one unit along the axis."""
+    x = ((np.arange(n) + 0.5) / n * 2 - 1) * math.tan(outer)
+    xx, yy = np.meshgrid(x, x)
+    cos = 1 / np.sqrt(1 + xx * xx + yy * yy)
+    ci, co = math.cos(inner), math.cos(outer)
+    t = np.clip((cos - co) / (ci - co), 0, 1)
+    return np.repeat((t * t)[:, :, None], 3, axis=2).astype(np.float32)
 
 
 def render_raytty(binary, scene, width, height, spp, out):

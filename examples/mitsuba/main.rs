@@ -1,5 +1,6 @@
 //! Writes a raytty scene for Mitsuba 3: its triangles as one Wavefront OBJ per material, and
-//! `scene.json` with the camera, the materials and the point lights in raytty's units (see
+//! `scene.json` with the camera, the materials and the lights (point, directional, spot, the
+//! environment) in raytty's units (see
 //! `compare.py`, which renders the result with Mitsuba and compares it with raytty's frame).
 //!
 //! `cargo run --release --example mitsuba -- SCENE OUT_DIR` (SCENE: a built-in name or a
@@ -89,12 +90,36 @@ fn main() {
             )
         })
         .collect();
+    let directional: Vec<String> = scene
+        .directional_lights()
+        .iter()
+        .map(|l| {
+            let (d, e) = (l.direction, l.irradiance);
+            format!(
+                "    {{\"direction\": [{}, {}, {}], \"irradiance\": [{}, {}, {}]}}",
+                d.x, d.y, d.z, e.x, e.y, e.z
+            )
+        })
+        .collect();
+    let spots: Vec<String> = scene
+        .spot_lights()
+        .iter()
+        .map(|l| {
+            let (p, d, w) = (l.position, l.direction, l.power);
+            format!(
+                "    {{\"position\": [{}, {}, {}], \"direction\": [{}, {}, {}], \"power\": [{}, {}, {}], \"inner\": {}, \"outer\": {}}}",
+                p.x, p.y, p.z, d.x, d.y, d.z, w.x, w.y, w.z, l.inner, l.outer
+            )
+        })
+        .collect();
+    let env = scene.environment();
     let cam = scene.camera();
     let (p, f, d) = (cam.position, cam.forward(), cam.down());
     let json = format!(
         "{{\n  \"scene\": \"{name}\",\n  \"camera\": {{\"origin\": [{}, {}, {}], \"forward\": [{}, {}, {}], \
          \"down\": [{}, {}, {}], \"fov_degrees\": {}, \"fov_axis\": \"{}\"}},\n  \"materials\": [\n{materials}\n  ],\n  \
-         \"lights\": [\n{}\n  ]\n}}\n",
+         \"lights\": [\n{}\n  ],\n  \"directional\": [\n{}\n  ],\n  \"spots\": [\n{}\n  ],\n  \
+         \"environment\": [{}, {}, {}]\n}}\n",
         p.x,
         p.y,
         p.z,
@@ -110,7 +135,12 @@ fn main() {
             .map_or(2.0 * 0.5f64.atan().to_degrees(), |f| f64::from(f)
                 .to_degrees()),
         if cam.fov.is_some() { "y" } else { "smaller" },
-        lights.join(",\n")
+        lights.join(",\n"),
+        directional.join(",\n"),
+        spots.join(",\n"),
+        env.x,
+        env.y,
+        env.z
     );
     std::fs::write(out.join("scene.json"), json).unwrap();
     eprintln!(
