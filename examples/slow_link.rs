@@ -248,6 +248,13 @@ fn run_pixels(
         }
         std::thread::sleep(Duration::from_millis(2));
     }
+    if std::env::var_os("SLOW_LINK_DEBUG").is_some() {
+        let (s, _, _) = link.snapshot();
+        eprintln!(
+            "status: {}",
+            s.contents_between(rows - 1, 0, rows - 1, cols)
+        );
+    }
     Row {
         bytes: exact.map_or(link.snapshot().1, |(_, b)| b) - bytes_before,
         close,

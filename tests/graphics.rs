@@ -8,7 +8,7 @@ use std::process::Command;
 mod graphics;
 
 use graphics::{decode_kitty, decode_sixel};
-use raytty::frame::{encode_kitty, encode_sixel};
+use raytty::frame::{Precision, encode_kitty, encode_sixel};
 use raytty::{Options, Stage, cornell_box};
 
 fn frame(w: u32, h: u32) -> Vec<[u8; 3]> {
@@ -114,7 +114,7 @@ fn a_terminal_reading_the_escapes_in_pieces_shows_each_picture_whole() {
         id: 1,
         cells: (4, 2),
     };
-    raytty::frame::encode_kitty_placed(&rgb, w, h, place, &mut kitty);
+    raytty::frame::encode_kitty_placed(&rgb, w, h, place, Precision::Exact, &mut kitty);
     let mut sixel = Vec::new();
     encode_sixel(&rgb, w, h, &mut sixel);
     let mut stream = b"\x1b[2J\x1b[3;4Hab".to_vec();
@@ -166,4 +166,43 @@ fn a_terminal_reading_the_escapes_in_pieces_shows_each_picture_whole() {
             }
         }
     }
+}
+
+#[test]
+fn a_near_kitty_frame_is_within_8_levels_in_a_fraction_of_the_bytes() {
+    let (w, h) = (300, 200);
+    let rgb = frame(w, h);
+    let place = raytty::frame::Placement {
+        id: 1,
+        cells: (30, 10),
+    };
+    let mut sizes = Vec::new();
+    for precision in [Precision::Exact, Precision::Near] {
+        let mut out = Vec::new();
+        raytty::frame::encode_kitty_placed(&rgb, w, h, place, precision, &mut out);
+        let k = decode_kitty(&out);
+        let (dw, dh, px) = k.image();
+        assert_eq!((dw, dh), (w, h));
+        let worst = px
+            .iter()
+            .zip(&rgb)
+            .flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c])))
+            .max()
+            .unwrap();
+        match precision {
+            Precision::Exact => assert_eq!((k.key("f"), worst), (Some("24"), 0)),
+            Precision::Near => {
+                assert_eq!(k.key("f"), Some("100"), "PNG");
+                assert!(worst <= raytty::frame::NEAR_LEVELS, "{worst} levels off");
+                assert!(worst > 0, "rounded");
+            }
+        }
+        sizes.push(out.len());
+    }
+    assert!(
+        sizes[1] * 3 < sizes[0],
+        "near {} B, exact {} B",
+        sizes[1],
+        sizes[0]
+    );
 }

@@ -14,7 +14,10 @@ pub use diff::{
     encode_diff_within, pixels,
 };
 
-pub use kitty::{DELETE_ALL as KITTY_DELETE_ALL, Placement, encode_kitty, encode_kitty_placed};
+pub use kitty::{
+    DELETE_ALL as KITTY_DELETE_ALL, NEAR_LEVELS, Placement, Precision, encode_kitty,
+    encode_kitty_placed,
+};
 pub use sixel::{encode_sixel, palette as sixel_palette};
 
 pub use cells::{CellMode, FULL_SHAPE, SHAPE_ROWS, cell_pixels, glyph_for_shape, paint, shape};

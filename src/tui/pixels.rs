@@ -4,7 +4,7 @@
 
 use std::time::Duration;
 
-use raytty::frame::{Placement, encode_kitty_placed, encode_sixel};
+use raytty::frame::{Placement, Precision, encode_kitty_placed, encode_sixel};
 
 use super::detect::{Protocol, tmux_passthrough};
 
@@ -24,6 +24,29 @@ pub const MOVE_RENDER: Duration = Duration::from_millis(40);
 /// (25-40 ms in xterm, kitty, VTE), so a held key does not start a full render between
 /// repeats.
 pub const SETTLE: Duration = Duration::from_millis(80);
+
+/// The longest wait for an exact frame (see [`exact_settle`]): an exact frame holds a
+/// 1 Mbit/s link for about a second (1200×780: 130 kB), so it waits until the keys have
+/// surely stopped (a held key repeats every 25-40 ms; `examples/slow_link` presses every
+/// 100 ms), and by then the near frame is through the link.
+pub const EXACT_SETTLE: Duration = Duration::from_millis(300);
+
+/// On a slow link (one the writer gave a frame budget), kitty's frames are sent within
+/// [`NEAR_LEVELS`](raytty::frame::NEAR_LEVELS) while the view moves and in the first full
+/// frame after it stopped (a fifth of an exact frame's bytes); the exact frame goes once
+/// nothing has changed for as long as it will hold the link (by the measured `costs` of an
+/// exact frame of `full` size and the link's `rate`): a key pressed while it is on the link
+/// then waits at most as long as the keys had been still. At least [`SETTLE`], at most
+/// [`EXACT_SETTLE`] (also when unmeasured).
+pub fn exact_settle(full: (u32, u32), costs: Costs, rate: Option<f64>) -> Duration {
+    match (costs.bytes, rate) {
+        (Some(per), Some(rate)) if rate > 0.0 => {
+            let bytes = per * f64::from(full.0) * f64::from(full.1);
+            Duration::from_secs_f64((bytes / rate).min(1e3)).clamp(SETTLE, EXACT_SETTLE)
+        }
+        _ => EXACT_SETTLE,
+    }
+}
 
 /// Before anything was measured: a first frame is rendered at most this many pixels, so it
 /// shows at once, and refined when it has.
@@ -71,13 +94,17 @@ pub fn scaled(full: (u32, u32), scale: u32) -> (u32, u32) {
 pub struct Costs {
     /// Render time per pixel in seconds, once measured.
     pub seconds: Option<f64>,
-    /// Bytes per rendered pixel, once measured.
+    /// Bytes per rendered pixel of an exact frame, once measured.
     pub bytes: Option<f64>,
+    /// Bytes per rendered pixel of a frame within [`NEAR_LEVELS`](raytty::frame::NEAR_LEVELS),
+    /// once measured (the moving frames on a slow link).
+    pub near_bytes: Option<f64>,
 }
 
 /// The finest scale (1 = full) at which a moving frame of `full` size renders within
-/// [`MOVE_RENDER`] and fits `budget` bytes, by the measured `costs`; before any measurement,
-/// the finest at most [`FIRST_PIXELS`].
+/// [`MOVE_RENDER`] and fits `budget` bytes, by the measured `costs` (of a near frame: a budget
+/// is a slow link's, where moving frames are near; of an exact one until a near one was
+/// measured); before any measurement, the finest at most [`FIRST_PIXELS`].
 pub fn moving_scale(full: (u32, u32), costs: Costs, budget: Option<usize>) -> u32 {
     (1..=MAX_SCALE)
         .find(|&s| {
@@ -87,7 +114,7 @@ pub fn moving_scale(full: (u32, u32), costs: Costs, budget: Option<usize>) -> u3
                 Some(t) => px * t <= MOVE_RENDER.as_secs_f64(),
                 None => px <= FIRST_PIXELS as f64,
             };
-            let bytes_ok = match (budget, costs.bytes) {
+            let bytes_ok = match (budget, costs.near_bytes.or(costs.bytes)) {
                 (Some(b), Some(per)) => px * per <= b as f64,
                 _ => true,
             };
@@ -114,15 +141,18 @@ pub fn upscale(rgb: &[[u8; 3]], w: u32, h: u32, full: (u32, u32)) -> Vec<[u8; 3]
 }
 
 /// The bytes that show `rgb` (`w × h`) over the image area, from the top-left cell: kitty
-/// scales it to `cells` (columns, rows) and replaces the last frame in place; sixel gets it
-/// scaled up to `full` screen pixels first (it draws one to one). Through tmux's passthrough
-/// if `tmux`, with the cursor placed inside it (tmux does not know where an image goes).
+/// scales it to `cells` (columns, rows) and replaces the last frame in place, sent at
+/// `precision`; sixel gets it scaled up to `full` screen pixels first (it draws one to one;
+/// its palette is its only precision). Through tmux's passthrough if `tmux`, with the cursor
+/// placed inside it (tmux does not know where an image goes).
+#[allow(clippy::too_many_arguments)]
 pub fn frame_bytes(
     protocol: Protocol,
     rgb: &[[u8; 3]],
     (w, h): (u32, u32),
     full: (u32, u32),
     cells: (u32, u32),
+    precision: Precision,
     tmux: bool,
     out: &mut Vec<u8>,
 ) {
@@ -133,7 +163,7 @@ pub fn frame_bytes(
                 id: IMAGE_ID,
                 cells,
             };
-            encode_kitty_placed(rgb, w, h, place, &mut image);
+            encode_kitty_placed(rgb, w, h, place, precision, &mut image);
         }
         Protocol::Sixel => {
             let big = upscale(rgb, w, h, full);
@@ -187,14 +217,40 @@ mod tests {
         let fast = Costs {
             seconds: Some(1e-8),
             bytes: Some(1.0),
+            near_bytes: None,
         };
         assert_eq!(moving_scale(full, fast, None), 1);
         assert_eq!(moving_scale(full, fast, Some(100_000)), 4);
+        // Near frames measured at a fifth of the bytes: at 1/2 rather than 1/4.
+        let near = Costs {
+            near_bytes: Some(0.2),
+            ..fast
+        };
+        assert_eq!(moving_scale(full, near, Some(100_000)), 2);
         let slow = Costs {
             seconds: Some(1e-5),
-            bytes: None,
+            ..Costs::default()
         };
         assert_eq!(moving_scale(full, slow, None), MAX_SCALE);
+    }
+
+    #[test]
+    fn the_exact_frame_waits_as_long_as_it_holds_the_link() {
+        let full = (1200, 780);
+        let costs = Costs {
+            bytes: Some(0.14),
+            ..Costs::default()
+        };
+        // 131 kB: 1.05 s at 1 Mbit/s (the most: 300 ms), 105 ms at 10, 10 ms at 100 (SETTLE).
+        assert_eq!(exact_settle(full, costs, Some(125e3)), EXACT_SETTLE);
+        let ten = exact_settle(full, costs, Some(1.25e6));
+        assert!((ten.as_secs_f64() - 0.105).abs() < 1e-3, "{ten:?}");
+        assert_eq!(exact_settle(full, costs, Some(12.5e6)), SETTLE);
+        assert_eq!(
+            exact_settle(full, Costs::default(), Some(125e3)),
+            EXACT_SETTLE
+        );
+        assert_eq!(exact_settle(full, costs, None), EXACT_SETTLE);
     }
 
     #[test]

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use raytty::bench::timing::ms;
 use raytty::denoise::{Guides, denoise};
-use raytty::frame::{CellMode, DiffLimits, UNLIKE, distance, encode_diff_within};
+use raytty::frame::{CellMode, DiffLimits, Precision, UNLIKE, distance, encode_diff_within};
 use raytty::{
     Camera, CellGrid, ColorMode, FrameStats, HitCache, Image, Options, Output, Stage, printable,
 };
@@ -102,6 +102,9 @@ pub struct Screen {
     image_sent: bool,
     /// Pixel modes: what frames cost per rendered pixel.
     costs: Costs,
+    /// Pixel modes: how close to the image the next image sent is (near while moving on a
+    /// slow link, and until [`pixels::exact_settle`]).
+    precision: Precision,
     /// The link as the writer measures it: each frame is fitted to its budget.
     pub link: LinkView,
 }
@@ -164,6 +167,7 @@ impl Screen {
             showing: None,
             image_sent: false,
             costs: Costs::default(),
+            precision: Precision::Exact,
         }
     }
 
@@ -191,10 +195,19 @@ impl Screen {
     }
 
     /// Pixel modes: how long until the reduced image on screen is rendered again at full
-    /// resolution (zero: now), if it is reduced. The event loop waits at most this long.
+    /// resolution, or the near one sent exactly (zero: now), if it is either. The event loop
+    /// waits at most this long.
     pub fn upgrade_in(&self, app: &App) -> Option<Duration> {
-        (app.graphics().is_some() && self.scale > 1)
-            .then(|| SETTLE.saturating_sub(self.changed_at.elapsed()))
+        let p = app.graphics()?;
+        let settle = if self.scale > 1 {
+            SETTLE
+        } else if self.precision == Precision::Near {
+            let full = pixels::full_size(p, app.size, app.cell_pixels, app.sixel_max);
+            pixels::exact_settle(full, self.costs, self.link.rate)
+        } else {
+            return None;
+        };
+        Some(settle.saturating_sub(self.changed_at.elapsed()))
     }
 
     /// The size the image is rendered at: the cell mode's pixels a cell, or in a pixel mode
@@ -210,32 +223,49 @@ impl Screen {
         }
     }
 
-    /// Picks the scale of the next render: a change of the image's inputs renders at the
-    /// moving scale (see [`pixels::moving_scale`]), and [`SETTLE`] after the last change at
-    /// full resolution.
-    fn pick_scale(&mut self, app: &App) {
+    /// Picks the scale and precision of the next frame: a change of the image's inputs
+    /// renders at the moving scale (see [`pixels::moving_scale`]), [`SETTLE`] after the last
+    /// change at full resolution, and on a slow link kitty's frames are near until
+    /// [`pixels::exact_settle`]. Whether only the precision changed (the image is the same:
+    /// it is sent again, not rendered again).
+    fn pick_scale(&mut self, app: &App) -> bool {
         let Some(p) = app.graphics() else {
             self.scale = 1;
-            return;
+            self.precision = Precision::Exact;
+            return false;
         };
         if self.generation != Some(app.generation) {
             self.changed_at = Instant::now();
             let full = pixels::full_size(p, app.size, app.cell_pixels, app.sixel_max);
             self.scale = pixels::moving_scale(full, self.costs, self.link.budget);
+            self.precision = if p == Protocol::Kitty && self.link.budget.is_some() {
+                Precision::Near
+            } else {
+                Precision::Exact
+            };
         } else if self.upgrade_in(app) == Some(Duration::ZERO) {
-            self.scale = 1;
+            if self.scale > 1 {
+                self.scale = 1;
+            } else {
+                self.precision = Precision::Exact;
+                return self.render_size(app) == Some((self.image.width, self.image.height));
+            }
         }
+        false
     }
 
     /// Renders one frame, or one more progressive pass in the GI stage (which restarts when
     /// the app's generation changes, but for a light move, which keeps a bounded history: see
     /// [`LIGHT_MOVE_HISTORY`]). Does nothing if the terminal is too small.
     pub fn render(&mut self, app: &App) {
-        self.pick_scale(app);
+        let resend = self.pick_scale(app);
         let Some((w, h)) = self.render_size(app) else {
             return;
         };
         self.image_sent = false;
+        if resend {
+            return;
+        }
         let mut history = u32::MAX;
         if (w, h) != (self.image.width, self.image.height)
             && self.generation == Some(app.generation)
@@ -422,8 +452,14 @@ impl Screen {
             let full = pixels::full_size(p, app.size, app.cell_pixels, app.sixel_max);
             let cells = (u32::from(app.size.0), u32::from(app.size.1) - 1);
             let before = out.len();
-            pixels::frame_bytes(p, &shown.to_rgb8(), (w, h), full, cells, app.tmux, &mut out);
-            self.costs.bytes = Some((out.len() - before) as f64 / (f64::from(w) * f64::from(h)));
+            let precision = self.precision;
+            let rgb = shown.to_rgb8();
+            pixels::frame_bytes(p, &rgb, (w, h), full, cells, precision, app.tmux, &mut out);
+            let per_pixel = Some((out.len() - before) as f64 / (f64::from(w) * f64::from(h)));
+            match precision {
+                Precision::Exact => self.costs.bytes = per_pixel,
+                Precision::Near => self.costs.near_bytes = per_pixel,
+            }
             self.image_sent = true;
         }
         let (cols, rows) = (app.size.0 as usize, app.size.1 as usize);
@@ -508,7 +544,9 @@ impl Screen {
             (format!("{}B", self.stats.bytes), 8),
             (format!("link {}", describe(self.link.rate)), 7),
             (
-                if self.approximate {
+                // Text cells left within a tolerance, or a pixel frame sent near.
+                if self.approximate || (self.showing.is_some() && self.precision == Precision::Near)
+                {
                     "approximate".into()
                 } else {
                     String::new()

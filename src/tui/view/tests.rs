@@ -367,6 +367,55 @@ fn kitty_frames_replace_one_image_and_refine_to_full_resolution() {
     assert!(contains(&s.draw(&a), b"\x1b_Ga=T"));
 }
 
+/// kitty over a slow link (a frame budget): a move is sent within 8 levels (PNG), then at
+/// full resolution still within 8 levels ("approximate") once settled, then the same image
+/// exactly (zlib RGB), sent again without rendering again.
+#[test]
+fn kitty_over_a_slow_link_sends_near_frames_then_the_exact_one() {
+    let mut a = pixel_app(Protocol::Kitty);
+    let mut s = Screen::new();
+    s.render(&a);
+    assert!(
+        contains(&s.draw(&a), b"\x1b_Ga=T,f=24,o=z"),
+        "unmeasured: exact"
+    );
+    s.link = LinkView {
+        budget: Some(8_000),
+        rate: Some(125e3),
+    };
+    s.costs.seconds = Some(1e-5);
+    update(&mut a, Message::Walk(0.1));
+    s.render(&a);
+    assert!(s.image.width < 160, "{}", s.image.width);
+    let moved = s.draw(&a);
+    assert!(
+        contains(&moved, b"\x1b_Ga=T,f=100,q=2"),
+        "a moving frame is near"
+    );
+    assert!(contains(&moved, b"approximate"));
+    s.changed_at -= SETTLE;
+    assert!(s.needs_render(&a));
+    s.render(&a);
+    assert_eq!((s.image.width, s.image.height), (160, 96));
+    let settled = s.draw(&a);
+    assert!(contains(&settled, b"f=100,q=2,s=160,v=96"), "full and near");
+    assert!(s.upgrade_in(&a).is_some_and(|t| t > Duration::ZERO));
+    let rendered = s.stats.render.elapsed;
+    s.changed_at -= pixels::EXACT_SETTLE;
+    assert_eq!(s.upgrade_in(&a), Some(Duration::ZERO));
+    assert!(s.needs_render(&a));
+    s.render(&a);
+    assert_eq!(s.stats.render.elapsed, rendered, "not rendered again");
+    let exact = s.draw(&a);
+    assert!(
+        contains(&exact, b"f=24,o=z,q=2,s=160,v=96"),
+        "full and exact"
+    );
+    assert!(!contains(&exact, b"approximate"));
+    assert_eq!(s.upgrade_in(&a), None);
+    assert!(!s.needs_render(&a));
+}
+
 /// sixel: the image is drawn one to one at the terminal's pixels (whole bands of six rows),
 /// and pixels off (G) goes back to text cells over a cleared screen.
 #[test]
