@@ -507,6 +507,7 @@ mod models {
             "cube_binary.stl",
             "two_nodes.gltf",
             "cube.glb",
+            "checker.glb",
         ]
         .into_iter()
         .map(|n| {
@@ -616,7 +617,10 @@ mod models {
         let (mut loaded, mut refused) = (0, 0);
         for i in 0..iterations {
             let (name, format, base) = &seeds[(i % seeds.len() as u64) as usize];
-            let text = !matches!(*name, "cube_binary.ply" | "cube_binary.stl" | "cube.glb");
+            let text = !matches!(
+                *name,
+                "cube_binary.ply" | "cube_binary.stl" | "cube.glb" | "checker.glb"
+            );
             let mutated = |rng: &mut Rng, b: &[u8]| {
                 if text && rng.next_u64().is_multiple_of(2) {
                     super::mutate(rng, &String::from_utf8_lossy(b)).into_bytes()

@@ -9,6 +9,8 @@ pub mod file;
 pub mod model;
 pub mod obj;
 pub mod procedural;
+pub mod texture;
+pub mod vertex;
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -24,6 +26,10 @@ use crate::geometry::{Aabb, DegenerateTriangle, Ray, RayTile, Triangle};
 use crate::image::ToneMap;
 use crate::light::AreaLights;
 use crate::sampler::Sampler;
+
+pub use model::srgb_to_linear;
+pub use texture::Texture;
+pub use vertex::VertexData;
 
 /// Largest absolute coordinate accepted anywhere a user gives one (scene files, OBJ vertices,
 /// `--camera` and `--light`; box corners and transformed vertices too): far beyond any sensible
@@ -219,6 +225,9 @@ pub struct Scene {
     step: f32,
     tone_map: ToneMap,
     centre: Vec3,
+    /// The vertices' normals, texture coordinates, colours and textures; `None` for a scene
+    /// that has none of them, which shades exactly as the seed's scenes do.
+    vertex: Option<Box<VertexData>>,
 }
 
 /// Why a scene could not be built.
@@ -253,6 +262,11 @@ pub enum SceneError {
         /// Index of the light among its kind.
         index: usize,
     },
+    /// The vertex data does not fit the triangles or materials (see [`VertexData`]).
+    VertexData {
+        /// What does not fit.
+        problem: String,
+    },
 }
 
 impl std::fmt::Display for SceneError {
@@ -272,6 +286,7 @@ impl std::fmt::Display for SceneError {
                 f,
                 "{kind} light {index}: positions must be finite, directions finite and not zero, power finite and non-negative, angles 0 <= inner <= outer <= 90 degrees"
             ),
+            SceneError::VertexData { problem } => write!(f, "vertex data: {problem}"),
         }
     }
 }
@@ -296,6 +311,7 @@ pub struct SceneBuilder {
     default_lights: bool,
     step: Option<f32>,
     tone_map: ToneMap,
+    vertex: Option<VertexData>,
 }
 
 /// Stands in for a degenerate triangle while validating; never part of a scene.
@@ -356,6 +372,13 @@ impl SceneBuilder {
         self.tone_map = t;
     }
 
+    /// Gives the triangles per-vertex data (normals, texture coordinates, colours, textures),
+    /// for all the triangles added by the time the scene is built. Data that changes nothing
+    /// ([`VertexData::calls_for_anything`]) is not kept.
+    pub fn vertex_data(&mut self, data: VertexData) {
+        self.vertex = Some(data);
+    }
+
     /// Adds a light.
     pub fn light(&mut self, l: PointLight) {
         self.lights.push(l);
@@ -408,6 +431,13 @@ impl SceneBuilder {
                 .collect_into_vec(&mut triangles);
         }
         let mut objects = self.objects;
+        let mut vertex = self.vertex.filter(VertexData::calls_for_anything);
+        if let Some(v) = &mut vertex {
+            if let Some(problem) = v.problem(self.raw.len(), self.materials.len()) {
+                return Err(SceneError::VertexData { problem });
+            }
+            v.sanitise();
+        }
         if failed.load(Ordering::Relaxed) && self.drop_degenerate {
             // Keep the valid triangles in order, each object's range shrunk to its own.
             let mut kept = Vec::with_capacity(triangles.len());
@@ -423,6 +453,12 @@ impl SceneBuilder {
                 ranges.push(start..kept.len());
             }
             ranges.retain(|r| !r.is_empty());
+            if let Some(v) = &mut vertex {
+                v.retain_triangles(|i| {
+                    let ([a, b, c], m) = self.raw[i];
+                    Triangle::new(a, b, c, m).is_ok()
+                });
+            }
             triangles = kept;
             objects = ranges;
         } else if failed.into_inner() {
@@ -542,6 +578,7 @@ impl SceneBuilder {
             } else {
                 Vec3::ZERO
             },
+            vertex: vertex.map(Box::new),
         })
     }
 }
@@ -730,11 +767,28 @@ impl Scene {
     }
 
     /// The base colour at a hit on `triangle` at barycentrics `b`: the one place a hit's colour
-    /// is looked up (today the material's constant colour; textures would be read here).
+    /// is looked up. The material's colour, times the interpolated vertex colour and the
+    /// base-colour texture where the scene has them ([`VertexData::base_colour`]).
     #[inline]
     pub fn base_colour(&self, triangle: u32, b: [f32; 3]) -> Vec3 {
-        let _ = b;
-        self.materials[self.triangles[triangle as usize].material as usize].colour
+        let material = self.triangles[triangle as usize].material;
+        let colour = self.materials[material as usize].colour;
+        match &self.vertex {
+            None => colour,
+            Some(v) => v.base_colour(colour, triangle, material, b),
+        }
+    }
+
+    /// Whether some triangle's base colour changes across it (vertex colours or a texture):
+    /// if not, [`Scene::base_colour`] is the material's colour wherever a triangle is hit.
+    #[inline]
+    pub fn colour_varies(&self) -> bool {
+        self.vertex.as_ref().is_some_and(|v| v.colour_varies())
+    }
+
+    /// The scene's per-vertex data, if it has any that changes a frame.
+    pub fn vertex_data(&self) -> Option<&VertexData> {
+        self.vertex.as_deref()
     }
 
     /// The emitting triangles as lights, picked by power (`None` when nothing emits).

@@ -341,6 +341,9 @@ impl Tracer<'_> {
             _ => 0.0,
         };
         debug_assert!(m <= k);
+        // Whether a triangle's colour changes across it (vertex colours, textures): then each
+        // pixel's is looked up, even where a block's pixels share a triangle.
+        let varies = self.scene.colour_varies();
         for c in 0..chunks {
             let o = c * w;
             let count = (m - o).min(w);
@@ -353,7 +356,7 @@ impl Tracer<'_> {
                         let b = [g.b[0][j], g.b[1][j], g.b[2][j]];
                         self.scene.base_colour(g.tri[j], b)
                     };
-                    let rho = if same >> c & 1 == 1 {
+                    let rho = if same >> c & 1 == 1 && !varies {
                         let rho = albedo(0);
                         each3!(|a| s.splat(rho[a]))
                     } else {

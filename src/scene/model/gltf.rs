@@ -14,11 +14,13 @@ use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;
 use ::gltf::{Gltf, Node, buffer};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use std::collections::HashMap;
 
 use super::{
     FileReader, Model, ModelCamera, ModelLight, ModelLightKind, ModelMaterial, check_triangles,
 };
 use crate::scene::file::SceneFileError;
+use crate::scene::texture::{Filter, Texture, Wrap};
 
 /// The extensions a file may require: those read here, and those whose absence only loses
 /// quality (`KHR_materials_volume`, `_specular`: parsed, for the materials to come).
@@ -70,8 +72,17 @@ pub fn parse(bytes: &[u8], file: &str, read: FileReader) -> Result<Model, SceneF
     // Material 0 is the default; glTF material i is i + 1.
     model.materials.push(ModelMaterial::default());
     let root = gltf.document.as_json();
+    let mut decoded = HashMap::new();
     for m in gltf.materials() {
-        model.materials.push(material(&m, root, &mut model.notes));
+        let mut mm = material(&m, root);
+        if let Some(i) = m.index() {
+            let files = Files {
+                buffers: &buffers,
+                read,
+            };
+            mm.texture = base_colour_texture(i, root, &files, &mut model, &mut decoded);
+        }
+        model.materials.push(mm);
     }
     let roots: Vec<Node> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
         Some(s) => s.nodes().collect(),
@@ -347,28 +358,18 @@ fn percent_decode(uri: &str) -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
-fn material(
-    m: &::gltf::Material,
-    root: &::gltf::json::Root,
-    notes: &mut Vec<String>,
-) -> ModelMaterial {
+fn material(m: &::gltf::Material, root: &::gltf::json::Root) -> ModelMaterial {
     let pbr = m.pbr_metallic_roughness();
     let base = Vec4::from(pbr.base_color_factor());
     // The image's URI from the JSON: the crate's `Image::source()` unwraps fields its validator
     // does not require.
     let texture = pbr.base_color_texture().map(|t| {
-        let image = t.texture().source().index();
-        match root.images.get(image).and_then(|i| i.uri.clone()) {
-            Some(uri) if !uri.starts_with("data:") => uri,
-            _ => format!("image {image} (embedded)"),
-        }
+        let image = root
+            .textures
+            .get(t.texture().index())
+            .map_or(usize::MAX, |t| t.source.value());
+        image_name(root, image)
     });
-    if let Some(t) = &texture {
-        let note = format!("texture {t}: not drawn yet (the base colour factor is)");
-        if !notes.contains(&note) {
-            notes.push(note);
-        }
-    }
     let finite01 = |x: f32| {
         if x.is_finite() {
             x.clamp(0.0, 1.0)
@@ -396,6 +397,121 @@ fn material(
             .map_or(0.0, |t| finite01(t.transmission_factor())),
         opacity: finite01(base.w),
         base_colour_texture: texture,
+        texture: None,
+    }
+}
+
+/// What a glTF's images are read from: its buffers, and the files beside it.
+struct Files<'a> {
+    buffers: &'a [Vec<u8>],
+    read: FileReader<'a>,
+}
+
+/// Image `image` as messages name it: its URI, or its index when it is embedded.
+fn image_name(root: &::gltf::json::Root, image: usize) -> String {
+    match root.images.get(image).and_then(|i| i.uri.as_deref()) {
+        Some(uri) if !uri.starts_with("data:") => format!("`{}`", percent_decode(uri)),
+        _ => format!("image {image} (embedded)"),
+    }
+}
+
+/// Material `i`'s base-colour texture as an index into `model.textures`, each image and
+/// sampler decoded once (`decoded`). A texture that cannot be drawn (its image missing or not
+/// a PNG or JPEG, or on a second set of texture coordinates) is a warning, and `None`: the
+/// material's base colour factor is drawn alone.
+fn base_colour_texture(
+    i: usize,
+    root: &::gltf::json::Root,
+    files: &Files,
+    model: &mut Model,
+    decoded: &mut HashMap<(usize, Option<usize>), Option<u32>>,
+) -> Option<u32> {
+    use ::gltf::json::texture::{MagFilter, WrappingMode};
+    use ::gltf::json::validation::Checked;
+    let info = root
+        .materials
+        .get(i)?
+        .pbr_metallic_roughness
+        .base_color_texture
+        .as_ref()?;
+    let at = format!("/materials/{i}/pbrMetallicRoughness/baseColorTexture");
+    let texture = root.textures.get(info.index.value())?;
+    let image = texture.source.value();
+    let name = image_name(root, image);
+    let warn = |model: &mut Model, why: String| {
+        model.note(format!(
+            "warning: texture {name} ({at}): {why}; the base colour factor is drawn instead"
+        ))
+    };
+    if info.tex_coord != 0 {
+        warn(
+            model,
+            format!(
+                "it uses TEXCOORD_{}, and raytty reads TEXCOORD_0 only",
+                info.tex_coord
+            ),
+        );
+        return None;
+    }
+    let sampler = texture.sampler.map(|s| s.value());
+    if let Some(&done) = decoded.get(&(image, sampler)) {
+        return done;
+    }
+    let result = image_bytes(root, image, files).and_then(|b| Texture::decode(&b));
+    let out = match result {
+        Ok(mut t) => {
+            if let Some(s) = sampler.and_then(|s| root.samplers.get(s)) {
+                let wrap = |w: &Checked<WrappingMode>| match w {
+                    Checked::Valid(WrappingMode::ClampToEdge) => Wrap::Clamp,
+                    Checked::Valid(WrappingMode::MirroredRepeat) => Wrap::Mirror,
+                    _ => Wrap::Repeat,
+                };
+                t.wrap = [wrap(&s.wrap_s), wrap(&s.wrap_t)];
+                if let Some(Checked::Valid(MagFilter::Nearest)) = s.mag_filter {
+                    t.filter = Filter::Nearest;
+                }
+            }
+            model.textures.push(t);
+            Some(model.textures.len() as u32 - 1)
+        }
+        Err(why) => {
+            warn(model, why);
+            None
+        }
+    };
+    decoded.insert((image, sampler), out);
+    out
+}
+
+/// Image `image`'s bytes: a `data:` URI's, a file's beside the model, or a buffer view's.
+fn image_bytes(root: &::gltf::json::Root, image: usize, files: &Files) -> Result<Vec<u8>, String> {
+    let Some(img) = root.images.get(image) else {
+        return Err(format!("image {image} does not exist"));
+    };
+    if let Some(uri) = &img.uri {
+        return uri_bytes(uri, files.read);
+    }
+    let Some(v) = img.buffer_view else {
+        return Err("the image has neither a uri nor a bufferView".into());
+    };
+    let view = root
+        .buffer_views
+        .get(v.value())
+        .ok_or_else(|| format!("buffer view {} does not exist", v.value()))?;
+    let data = files
+        .buffers
+        .get(view.buffer.value())
+        .ok_or_else(|| format!("buffer {} does not exist", view.buffer.value()))?;
+    let start = view.byte_offset.map_or(0, |o| o.0);
+    let end = start.checked_add(view.byte_length.0);
+    match end {
+        Some(end) if end <= data.len() as u64 => Ok(data[start as usize..end as usize].to_vec()),
+        _ => Err(format!(
+            "buffer view {} (bytes {start} to {} of a buffer of {}) does not fit its buffer",
+            v.value(),
+            start.saturating_add(view.byte_length.0),
+            data.len()
+        )),
     }
 }
 

@@ -6,8 +6,9 @@
 //!
 //! Materials keep every physically based value the file gives (metallic, roughness, emission,
 //! index of refraction, transmission, opacity, the base colour texture's name);
-//! [`scene_material`] maps them onto the scene's [`Material`] (metal, glass, emission; the base
-//! colour times the triangle's average vertex colour). Textures are not sampled yet.
+//! [`scene_material`] maps them onto the scene's [`Material`] (metal, glass, emission). Vertex
+//! colours, normals and base-colour textures go to the scene as its [`VertexData`], only when
+//! the model has them.
 //!
 //! Every mistake is a [`SceneFileError`] naming the file and where: a line and column in text,
 //! a JSON path in glTF, a byte offset in binary data.
@@ -20,7 +21,6 @@ pub mod progress;
 pub mod stl;
 pub mod view;
 
-use std::collections::HashMap;
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
@@ -28,7 +28,7 @@ use glam::{Vec2, Vec3};
 use crate::scene::file::{MAX_EMISSION, SceneFileError};
 use crate::scene::{
     DirectionalLight, Effects, MAX_COORDINATE, MAX_IOR, Material, PointLight, Scene, SceneBuilder,
-    SpotLight,
+    SpotLight, Texture, VertexData,
 };
 
 pub use progress::{LoadProgress, LoadStep};
@@ -89,8 +89,11 @@ pub struct ModelMaterial {
     pub transmission: f32,
     /// Opacity (glTF's base colour alpha, MTL's `d`), [0, 1].
     pub opacity: f32,
-    /// The base colour texture's file or URI, if any (not sampled yet).
+    /// The base colour texture's file or URI as the file names it, if any.
     pub base_colour_texture: Option<String>,
+    /// The base colour texture as decoded, an index into [`Model::textures`]; `None` when
+    /// there is none or it could not be read (a warning says why).
+    pub texture: Option<u32>,
 }
 
 impl Default for ModelMaterial {
@@ -106,6 +109,7 @@ impl Default for ModelMaterial {
             transmission: 0.0,
             opacity: 1.0,
             base_colour_texture: None,
+            texture: None,
         }
     }
 }
@@ -174,6 +178,8 @@ pub struct Model {
     pub triangle_materials: Vec<u32>,
     /// Materials (at least one once the model is read).
     pub materials: Vec<ModelMaterial>,
+    /// The materials' decoded base-colour textures.
+    pub textures: Vec<Texture>,
     /// The file's cameras, in its order.
     pub cameras: Vec<ModelCamera>,
     /// The file's point lights.
@@ -241,7 +247,7 @@ impl Model {
             .map_err(|e| SceneFileError::whole_file(file, e.to_string()))?;
         let mut b = SceneBuilder::new();
         b.drop_degenerate();
-        let materials = self.scene_materials(&mut b);
+        let (materials, material_textures) = self.scene_materials(&mut b);
         let positions = &self.positions;
         b.mesh(self.triangles.iter().enumerate().map(|(i, t)| {
             (
@@ -286,11 +292,7 @@ impl Model {
         }
         // The default rig only where nothing in the file gives light: no punctual light and
         // no emitting material.
-        let used: Vec<Material> = self
-            .materials
-            .iter()
-            .map(|m| scene_material(m, Vec3::ONE))
-            .collect();
+        let used: Vec<Material> = self.materials.iter().map(scene_material).collect();
         let emits = used.iter().any(|m| m.emission != Vec3::ZERO);
         let default_lights = self.lights.is_empty() && !emits;
         // Light from surfaces, metal and glass show only where light is path traced (as in the
@@ -315,8 +317,11 @@ impl Model {
         b.tone_map(crate::image::ToneMap::Neutral);
         // The Cornell box's diagonal is 2·√3: the keys' steps are the box's, scaled.
         b.step((bounds.1 - bounds.0).length() / (2.0 * 3f32.sqrt()));
-        let mut notes = self.notes;
         let triangles = self.triangles.len();
+        if let Some(v) = self.vertex_data(material_textures) {
+            b.vertex_data(v);
+        }
+        let mut notes = self.notes;
         drop(self.positions);
         drop(self.triangles);
         let scene = b
@@ -348,47 +353,54 @@ impl Model {
         (lo, hi)
     }
 
-    /// The scene's materials for the triangles, one index per triangle (or one for all): each
-    /// file material as [`scene_material`] maps it, its base colour times the triangle's
-    /// average vertex colour when the model has them (rounded to 8 bits a channel so that a
-    /// scan's colours share materials).
-    fn scene_materials(&self, b: &mut SceneBuilder) -> Vec<u32> {
-        if self.colours.is_empty() {
-            let ids: Vec<u32> = self
-                .materials
-                .iter()
-                .map(|m| b.material(scene_material(m, Vec3::ONE)))
-                .collect();
-            if self.triangle_materials.is_empty() {
-                return vec![ids[0]];
-            }
-            return self
-                .triangle_materials
-                .iter()
-                .map(|&m| ids[(m as usize).min(ids.len() - 1)])
-                .collect();
-        }
-        let mut ids: HashMap<(u32, [u8; 3]), u32> = HashMap::new();
-        self.triangles
+    /// The scene's materials for the triangles, one index per triangle (or one for all), and
+    /// for each scene material its texture: each file material as [`scene_material`] maps it.
+    fn scene_materials(&self, b: &mut SceneBuilder) -> (Vec<u32>, Vec<Option<u32>>) {
+        let ids: Vec<u32> = self
+            .materials
             .iter()
-            .enumerate()
-            .map(|(i, t)| {
-                let m = (self.material_of(i) as usize).min(self.materials.len() - 1);
-                let c = t.iter().map(|&v| self.colours[v as usize]).sum::<Vec3>() / 3.0;
-                let q = (c.clamp(Vec3::ZERO, Vec3::ONE) * 255.0)
-                    .round()
-                    .to_array()
-                    .map(|x| x as u8);
-                *ids.entry((m as u32, q)).or_insert_with(|| {
-                    let c = Vec3::from(q.map(|x| x as f32 / 255.0));
-                    b.material(scene_material(&self.materials[m], c))
-                })
-            })
-            .collect()
+            .map(|m| b.material(scene_material(m)))
+            .collect();
+        let textures = self.materials.iter().map(|m| m.texture).collect();
+        if self.triangle_materials.is_empty() {
+            return (vec![ids[0]], textures);
+        }
+        let per_triangle = self
+            .triangle_materials
+            .iter()
+            .map(|&m| ids[(m as usize).min(ids.len() - 1)])
+            .collect();
+        (per_triangle, textures)
+    }
+
+    /// What the vertices carry that changes a frame, for the scene (`None` if nothing):
+    /// colours, normals, and texture coordinates when a material has a texture.
+    /// `material_textures` is each scene material's texture. Takes the lists it keeps.
+    fn vertex_data(&mut self, material_textures: Vec<Option<u32>>) -> Option<VertexData> {
+        let textured = material_textures.iter().any(Option::is_some);
+        if self.colours.is_empty() && self.normals.is_empty() && !textured {
+            return None;
+        }
+        Some(VertexData {
+            corners: std::mem::take(&mut self.triangles),
+            normals: std::mem::take(&mut self.normals),
+            uvs: if textured {
+                std::mem::take(&mut self.uvs)
+            } else {
+                Vec::new()
+            },
+            colours: std::mem::take(&mut self.colours),
+            textures: std::mem::take(&mut self.textures),
+            material_textures: if textured {
+                material_textures
+            } else {
+                Vec::new()
+            },
+        })
     }
 }
 
-/// A file's material as a scene's, its base colour times `tint`: glTF's metallic-roughness
+/// A file's material as a scene's: glTF's metallic-roughness
 /// model (and MTL's `Pm`, `Pr`, `Ni`, `Ke` and glass `illum`, which the reader maps onto it)
 /// as raytty's materials take it: the metallic fraction a GGX conductor of F0 = base colour,
 /// the transmission fraction glass of the file's IOR, both of the file's roughness; the rest
@@ -396,7 +408,7 @@ impl Model {
 /// material yet); emission as the camera sees it. Values are clamped into the ranges a scene
 /// allows. A plain dielectric is exactly [`Material::diffuse`], so such models render as
 /// before. Opacity (glTF's alpha, MTL's `d` without a glass `illum`) is not simulated.
-fn scene_material(m: &ModelMaterial, tint: Vec3) -> Material {
+fn scene_material(m: &ModelMaterial) -> Material {
     let unit = |v: f32| {
         if v.is_finite() {
             v.clamp(0.0, 1.0)
@@ -404,7 +416,7 @@ fn scene_material(m: &ModelMaterial, tint: Vec3) -> Material {
             0.0
         }
     };
-    let colour = m.base_colour.clamp(Vec3::ZERO, Vec3::ONE).map(unit) * tint;
+    let colour = m.base_colour.clamp(Vec3::ZERO, Vec3::ONE).map(unit);
     let mut out = Material::diffuse(colour);
     let e = m.emission.map(|c| {
         if c.is_finite() {

@@ -3,7 +3,12 @@
 //! shows in the default material), as is a `usemtl` name no library defines; a mistake inside
 //! a library is an error at its line and column.
 
+use std::collections::HashMap;
+
+use glam::Vec2;
+
 use super::{FileReader, MAX_MODEL_TRIANGLES, Model, ModelMaterial, mtl};
+use crate::scene::Texture;
 use crate::scene::file::SceneFileError;
 use crate::scene::obj::{ObjError, line_text, parse_obj_model};
 
@@ -17,7 +22,12 @@ pub fn parse(bytes: &[u8], file: &str, read: FileReader) -> Result<Model, SceneF
     let mut model = Model {
         positions: obj.positions,
         normals: obj.normals,
-        uvs: obj.uvs,
+        // OBJ's v runs up from the image's bottom, the model's down from its top (glTF's).
+        uvs: obj
+            .uvs
+            .into_iter()
+            .map(|t| Vec2::new(t.x, 1.0 - t.y))
+            .collect(),
         triangles: obj.triangles,
         triangle_materials: obj.triangle_materials,
         ..Model::default()
@@ -31,6 +41,7 @@ pub fn parse(bytes: &[u8], file: &str, read: FileReader) -> Result<Model, SceneF
             Err(e) => model.note(format!("material library: {e}; default materials used")),
         }
     }
+    let mut decoded = HashMap::new();
     for name in &obj.material_names {
         let found = library.iter().rev().find(|m| &m.name == name);
         if found.is_none() && !name.is_empty() && !obj.libraries.is_empty() {
@@ -42,10 +53,43 @@ pub fn parse(bytes: &[u8], file: &str, read: FileReader) -> Result<Model, SceneF
             name: name.clone(),
             ..ModelMaterial::default()
         });
-        if let Some(t) = &m.base_colour_texture {
-            model.note(format!("texture {t}: not drawn yet (the base colour is)"));
+        let mut m = m;
+        if let Some(t) = m.base_colour_texture.clone() {
+            m.texture = texture(&t, &m.name, read, &mut model, &mut decoded);
         }
         model.materials.push(m);
     }
     Ok(model)
+}
+
+/// The texture `map_Kd name` names (for material `material`), as an index into
+/// `model.textures`, each file decoded once (`decoded`); one that cannot be read or decoded is
+/// a warning and `None` (the material's `Kd` is drawn alone). Its options (`-clamp`, `-o`,
+/// `-s` and the rest) are not read: the image repeats, filtered bilinearly.
+fn texture(
+    name: &str,
+    material: &str,
+    read: FileReader,
+    model: &mut Model,
+    decoded: &mut HashMap<String, Option<u32>>,
+) -> Option<u32> {
+    if let Some(&done) = decoded.get(name) {
+        return done;
+    }
+    let out = match read(name)
+        .and_then(|(shown, bytes)| Texture::decode(&bytes).map_err(|e| format!("{shown}: {e}")))
+    {
+        Ok(t) => {
+            model.textures.push(t);
+            Some(model.textures.len() as u32 - 1)
+        }
+        Err(why) => {
+            model.note(format!(
+                "warning: texture `{name}` (map_Kd of material `{material}`): {why}; the material's Kd is drawn instead"
+            ));
+            None
+        }
+    };
+    decoded.insert(name.to_string(), out);
+    out
 }

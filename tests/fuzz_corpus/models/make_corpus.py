@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the hostile model files of this corpus (run from this folder). Every file must be
 refused with a clear error, but those named ok_*, which must load."""
-import copy, json, struct
+import base64, copy, json, struct
 
 def w(name, data):
     with open(name, "wb") as f:
@@ -61,3 +61,26 @@ def image_without_mime(d):
     d["materials"] = [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]
     d["meshes"][0]["primitives"][0]["material"] = 0
 g("ok_image_without_mime.gltf", image_without_mime)
+
+
+# Textures never fail a load: each of these loads, with a warning, in the base colour factor.
+def textured(image, sampler=None, tex_coord=0):
+    def change(d):
+        d["images"] = [image]
+        d["textures"] = [{"source": 0} if sampler is None else {"source": 0, "sampler": 0}]
+        if sampler is not None:
+            d["samplers"] = [sampler]
+        d["materials"] = [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": tex_coord}}}]
+        d["meshes"][0]["primitives"][0]["material"] = 0
+    return change
+
+PNG_HEAD = b"\x89PNG\r\n\x1a\n" + struct.pack(">I", 13) + b"IHDR"
+g("ok_texture_missing_file.gltf", textured({"uri": "no_such_texture.png"}))
+g("ok_texture_not_an_image.gltf", textured({"uri": "data:image/png;base64,bm90IGFuIGltYWdl"}))
+g("ok_texture_truncated_png.gltf", textured({"uri": "data:image/png;base64," + base64.b64encode(PNG_HEAD + struct.pack(">II", 2, 2)).decode()}))
+g("ok_texture_huge_png.gltf", textured({"uri": "data:image/png;base64," + base64.b64encode(PNG_HEAD + struct.pack(">IIBBBBB", 100000, 100000, 8, 2, 0, 0, 0) + b"\0" * 4).decode()}))
+g("ok_texture_truncated_jpeg.gltf", textured({"uri": "data:image/jpeg;base64," + base64.b64encode(b"\xff\xd8\xff\xe0\0\x10JFIF\0").decode()}))
+g("ok_texture_second_texcoord.gltf", textured({"uri": "no_such_texture.png"}, tex_coord=1))
+g("ok_texture_odd_sampler.gltf", textured({"uri": "data:image/png;base64,bm90IGFuIGltYWdl"}, {"wrapS": 33648, "wrapT": 33071, "magFilter": 9728}))
+w("ok_colours_and_normals_nan.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float red\nproperty float green\nproperty float blue\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 nan 0 0 nan 2 -1\n1 0 0 0 0 0 inf 0 0\n0 1 0 0 0 1 0.5 0.5 0.5\n3 0 1 2\n")
+w("ok_texture_coordinates_far_out.obj", "mtllib cube.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 5e5 -5e5\nusemtl red\nf 1/1 2/2 3/1\n")
