@@ -104,8 +104,8 @@ fn render_writes_one_picture_in_each_protocol() {
 
 #[test]
 fn a_terminal_reading_the_escapes_in_pieces_shows_each_picture_whole() {
-    // Text, a kitty image placed at row 2 column 3 over 4×2 cells, text, a sixel at the top
-    // left: read in pieces of every size from 1 byte, the far end's screen gets the text
+    // Text, a kitty image placed at row 2 column 3 over 4×2 cells, text, an APC that is not
+    // kitty's, a sixel at the top left: read in pieces of every size from 1 byte, the far end's screen gets the text
     // unchanged and each picture whole, where the cursor was.
     let (w, h) = (8, 6);
     let rgb = frame(w, h);
@@ -120,7 +120,7 @@ fn a_terminal_reading_the_escapes_in_pieces_shows_each_picture_whole() {
     let mut stream = b"\x1b[2J\x1b[3;4Hab".to_vec();
     stream.extend_from_slice(b"\x1b[3;4H");
     stream.extend_from_slice(&kitty);
-    stream.extend_from_slice(b"\x1b[1;1Hcd\x1b[H");
+    stream.extend_from_slice(b"\x1b[1;1Hcd\x1b_Xnot kitty's\x1b\\\x1b[H");
     stream.extend_from_slice(&sixel);
     stream.extend_from_slice(b"\x1b[m");
     for piece in [1, 2, 3, 5, 64, stream.len()] {

@@ -353,6 +353,9 @@ impl PixelScreen {
             }
             return true;
         }
+        if !escape.starts_with(b"\x1b_G") {
+            return false; // an APC other than kitty's
+        }
         self.pending.extend_from_slice(escape);
         let keys = escape[3..].split(|&b| b == b';' || b == 0x1b).next();
         if keys.is_some_and(|k| k.split(|&b| b == b',').any(|kv| kv == b"m=1")) {
