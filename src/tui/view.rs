@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use raytty::bench::timing::ms;
-use raytty::denoise::{Guides, denoise};
+use raytty::denoise::{Guides, denoise_on};
 use raytty::frame::{CellMode, DiffLimits, Precision, UNLIKE, distance, encode_diff_within};
 use raytty::{
     Camera, CellGrid, ColorMode, FrameStats, HitCache, Image, Options, Output, Stage, printable,
@@ -332,7 +332,7 @@ impl Screen {
         }
         let Some(g) = &self.guides else { return };
         let start = Instant::now();
-        let d = denoise(g);
+        let d = denoise_on(app.scene.isa(), g);
         if app.denoise {
             self.spent += start.elapsed();
             self.error = (d.raw_error, d.error);
