@@ -42,6 +42,9 @@ fn text(b: &[u8]) -> String {
 const ROWS_PER_SIZE: usize = 5 + 2 + 4 * 2 + 3 * 2;
 const SIZES: usize = 2;
 
+/// The estimators' rows: 3 scenes × 3 estimators at the quick bench's one count (4 spp).
+const ESTIMATOR_ROWS: usize = 3 * 3;
+
 /// The throughput section's table: header, alignment, and one row per ray kind (the quick
 /// bench measures the Cornell box only).
 const THROUGHPUT_LINES: usize = 2 + 4;
@@ -55,6 +58,21 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
     let (accuracy, throughput) = stdout
         .split_once("Ray throughput")
         .expect("a throughput section");
+    let (accuracy, estimators) = accuracy
+        .split_once("The physically based effects")
+        .expect("an estimators section");
+    // The estimators' table: each physically based scene by each estimator, at the quick
+    // bench's 4 spp, each with an error.
+    let est: Vec<&str> = estimators.lines().filter(|l| l.starts_with('|')).collect();
+    assert_eq!(est.len(), 2 + ESTIMATOR_ROWS, "{stdout}");
+    for row in &est[2..] {
+        let cells: Vec<&str> = row.trim_matches('|').split('|').map(str::trim).collect();
+        assert!(["area", "plates", "glass"].contains(&cells[0]), "{row}");
+        assert!(["light", "bsdf", "mis"].contains(&cells[2]), "{row}");
+        assert_eq!(cells[3], "4", "{row}");
+        let rmse: f64 = cells[7].parse().expect("RMSE is a number");
+        assert!(rmse.is_finite() && rmse > 0.0, "{row}");
+    }
     let table: Vec<&str> = accuracy.lines().filter(|l| l.starts_with('|')).collect();
     assert_eq!(table.len(), 2 + SIZES * ROWS_PER_SIZE, "{stdout}");
     let rates: Vec<&str> = throughput.lines().filter(|l| l.starts_with('|')).collect();
@@ -157,7 +175,11 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
     assert!(stdout.contains(&cache.display().to_string()), "{stdout}");
     assert!(stdout.contains("the seed's constant N = 0.5 at 40x40: RMSE"));
     let cached = std::fs::read_dir(&cache).expect("the cache").count();
-    assert_eq!(cached, SIZES);
+    assert_eq!(
+        cached,
+        SIZES + 3,
+        "the Cornell box's at each size, the estimators' scenes'"
+    );
     // The second run reads it back.
     let again = bench(&dir.0, &[]);
     assert!(again.status.success());
@@ -167,10 +189,9 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
     // stderr, and rendered again.
     let file = std::fs::read_dir(&cache)
         .unwrap()
-        .next()
-        .unwrap()
-        .unwrap()
-        .path();
+        .map(|e| e.unwrap().path())
+        .find(|p| p.to_string_lossy().contains("reference-cornell-40x40"))
+        .expect("the Cornell box's 40x40 reference");
     std::fs::write(&file, "PF\n4294967295 4294967295\n-1.0\n\0\0\0\0").unwrap();
     let repaired = bench(&dir.0, &[]);
     let stderr = text(&repaired.stderr);
@@ -339,7 +360,7 @@ fn the_report_is_stamped_and_holds_the_printed_tables() {
     assert!(report.ends_with(&stdout), "{report}");
     assert_eq!(
         report.lines().filter(|l| l.starts_with('|')).count(),
-        2 + SIZES * ROWS_PER_SIZE + THROUGHPUT_LINES
+        2 + SIZES * ROWS_PER_SIZE + 2 + ESTIMATOR_ROWS + THROUGHPUT_LINES
     );
     // The stamp: the date, the commit (no git checkout here: the crate's version), the machine
     // and the command.

@@ -6,6 +6,7 @@
 //! the reference. Writing it out (tables, CSV, the charts, docs/performance.md) is the binary's.
 
 mod environment;
+pub mod estimators;
 pub mod metrics;
 pub mod progress;
 pub mod reference;

@@ -85,9 +85,22 @@ pub(super) fn run_bench(
     if a.csv {
         out.write_all(report::csv(&bench).as_bytes())?;
     } else {
+        let estimators = raytty::bench::estimators::run(&options, &mut Bar::default())
+            .with_context(|| {
+                format!(
+                    "cannot cache the references in {}",
+                    options.cache_dir.display()
+                )
+            })?;
+        for r in &estimators.1 {
+            for note in &r.refused {
+                writeln!(log, "raytty bench: {note}")?;
+            }
+            writeln!(log, "raytty bench: {}", r.describe())?;
+        }
         let rates = throughputs(&scene, a.quick, &options);
         let stamp = report::Stamp::now(&bench.environment, &command);
-        let body = report::body(&bench, &rates, &stamp);
+        let body = report::body(&bench, &estimators, &rates, &stamp);
         out.write_all(body.as_bytes())?;
         if let Some(path) = &a.report {
             let chart = a.svg.as_deref().and_then(|svg| chart_link(path, svg));
