@@ -786,6 +786,21 @@ impl Scene {
         self.vertex.as_ref().is_some_and(|v| v.colour_varies())
     }
 
+    /// Whether the scene has vertex normals (shading normals: [`Scene::shading_normal`]).
+    #[inline]
+    pub fn has_normals(&self) -> bool {
+        self.vertex.as_ref().is_some_and(|v| !v.normals.is_empty())
+    }
+
+    /// The shading normal at a hit on `triangle` at barycentrics `b`: its vertex normals
+    /// interpolated, unit length (facing as the file gives them); `None` where the scene has
+    /// no vertex normals or this triangle's give none, where the triangle's own normal
+    /// shades.
+    #[inline]
+    pub fn shading_normal(&self, triangle: u32, b: [f32; 3]) -> Option<Vec3> {
+        self.vertex.as_ref()?.normal(triangle, b)
+    }
+
     /// The scene's per-vertex data, if it has any that changes a frame.
     pub fn vertex_data(&self) -> Option<&VertexData> {
         self.vertex.as_deref()

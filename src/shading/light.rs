@@ -99,10 +99,12 @@ pub(crate) struct Incident<F> {
     pub traced: u32,
 }
 
-/// A point light at the points of `at`: irradiance `P·max(r̂·n̂, 0)/(4πr²)`, with `r²`
-/// clamped to `min_r2` (the scene's minimum light distance, squared), and where `shadows`
-/// the shadow ray (else none is traced: `traced` is 0). The light's power is not zero (a
-/// dark light is skipped before).
+/// A point light at the points of `at`: irradiance `P·max(r̂·n̂, 0)/(4πr²)` with n̂ the
+/// shading normal, `r²` clamped to `min_r2` (the scene's minimum light distance, squared),
+/// and where `shadows` the shadow ray (else none is traced: `traced` is 0). Where the scene
+/// has shading normals (`smooth`), a light must also be in front of the triangle itself: a
+/// light the shading normal sees from below the surface would leak through it. The light's
+/// power is not zero (a dark light is skipped before).
 #[inline(always)]
 pub(crate) fn point_light<S: Lanes>(
     s: S,
@@ -110,13 +112,17 @@ pub(crate) fn point_light<S: Lanes>(
     min_r2: f32,
     at: &Surface<S::F>,
     shadows: bool,
+    smooth: bool,
 ) -> Incident<S::F> {
     let zero = s.splat(0.0);
     let lp = light.position.to_array();
     let to_light = each3!(|k| s.sub(s.splat(lp[k]), at.p[k]));
     let dist2 = dot(s, to_light, to_light);
-    let cos = s.div(dot(s, at.normal, to_light), s.sqrt(dist2));
-    let lit = s.and(s.gt(dist2, zero), s.gt(cos, zero));
+    let cos = s.div(dot(s, at.shading, to_light), s.sqrt(dist2));
+    let mut lit = s.and(s.gt(dist2, zero), s.gt(cos, zero));
+    if smooth {
+        lit = s.and(lit, s.gt(dot(s, at.normal, to_light), zero));
+    }
     let lit_bits = s.bits(lit);
     if lit_bits == 0 {
         // Nothing to add, no ray to trace.
@@ -188,12 +194,17 @@ pub(crate) fn directional_light<S: Lanes>(
     reach: f32,
     at: &Surface<S::F>,
     shadows: bool,
+    smooth: bool,
 ) -> Incident<S::F> {
     let zero = s.splat(0.0);
     let l = (-light.direction).to_array();
     let toward = each3!(|k| s.splat(l[k]));
-    let cos = dot(s, at.normal, toward);
-    let lit = s.bits(s.gt(cos, zero));
+    let cos = dot(s, at.shading, toward);
+    let mut lit = s.gt(cos, zero);
+    if smooth {
+        lit = s.and(lit, s.gt(dot(s, at.normal, toward), zero));
+    }
+    let lit = s.bits(lit);
     if lit == 0 {
         return unlit(s);
     }
@@ -226,12 +237,13 @@ pub(crate) fn spot_light<S: Lanes>(
     min_r2: f32,
     at: &Surface<S::F>,
     shadows: bool,
+    smooth: bool,
 ) -> Incident<S::F> {
     let point = PointLight {
         position: light.position,
         power: light.power,
     };
-    let mut inc = point_light(s, &point, min_r2, at, shadows);
+    let mut inc = point_light(s, &point, min_r2, at, shadows, smooth);
     if inc.lit == 0 {
         return inc;
     }
@@ -357,7 +369,7 @@ mod tests {
             for light in [light, white] {
                 let one: Vec<Bits> = points
                     .iter()
-                    .map(|at| bits(&point_light(Scalar, &light, 1e-4, at, true)))
+                    .map(|at| bits(&point_light(Scalar, &light, 1e-4, at, true, false)))
                     .collect();
                 lit += one.iter().filter(|b| b.1).count();
                 #[cfg(target_arch = "x86_64")]
@@ -369,8 +381,9 @@ mod tests {
                         p: lanes(|a| a.p),
                         err: lanes(|a| a.err),
                         normal: lanes(|a| a.normal),
+                        shading: lanes(|a| a.shading),
                     };
-                    let eight = point_light(s, &light, 1e-4, &at, true);
+                    let eight = point_light(s, &light, 1e-4, &at, true, false);
                     let lane = |v: &[std::arch::x86_64::__m256; 3], l: usize| {
                         v.map(|v| {
                             let mut a = [0.0; 8];

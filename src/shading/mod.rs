@@ -23,7 +23,7 @@ mod surface;
 mod tile;
 
 use lane::{Lanes, Scalar};
-use surface::{Surface, offset_origin, surface};
+use surface::{Surface, offset_origin, surface, with_shading};
 
 pub use light::LightEffects;
 pub use path::{Estimator, PathEffects, PathRun};
@@ -62,6 +62,8 @@ pub struct Tracer<'a> {
     min_r2: f32,
     /// What the scene calls for of the physically based path ([`path`]).
     path_effects: PathEffects,
+    /// Whether the scene has vertex normals: shading normals, and the checks they need.
+    smooth: bool,
     /// The estimator the frame's settings resolve to for this scene.
     estimator: Estimator,
     /// How long a directional light's shadow ray is: longer than any segment within the
@@ -92,6 +94,7 @@ impl<'a> Tracer<'a> {
             settings,
             min_r2: r * r,
             path_effects,
+            smooth: scene.has_normals(),
             estimator: path_effects.estimator(settings.estimator),
             reach: 2.0 * scene.extent(),
             ambient: match (settings.mode, traced) {
@@ -193,7 +196,7 @@ impl<'a> Tracer<'a> {
                 ..SplitSample::default()
             };
         }
-        let at = surface_of(tri, hit, ray);
+        let at = surface_of(self.scene, hit, ray);
         let (p, normal) = (Vec3::from_array(at.p), Vec3::from_array(at.normal));
         if self.physical() {
             // Not split yet: the whole path is left to the denoiser's `rest`.
@@ -234,7 +237,7 @@ impl<'a> Tracer<'a> {
             return own;
         }
         let m = material.mirror;
-        let reflected_ray = mirror_ray(&at, ray);
+        let reflected_ray = self.mirror_ray(&at, ray);
         n.reflection += 1;
         let reflected = match self.scene.intersect(&reflected_ray, f32::INFINITY) {
             Some(h) => self.split(&reflected_ray, &h, mirror_depth + 1, rng, n),
@@ -292,7 +295,7 @@ impl<'a> Tracer<'a> {
         if self.settings.mode == Mode::Flat {
             return colour;
         }
-        let at = surface_of(tri, hit, ray);
+        let at = surface_of(self.scene, hit, ray);
         if self.settings.mode == Mode::Irradiance {
             return self.direct_at(&at, n);
         }
@@ -314,7 +317,8 @@ impl<'a> Tracer<'a> {
         };
         let shaded = if reflects {
             n.reflection += 1;
-            let reflected = self.trace(&mirror_ray(&at, ray), mirror_depth + 1, bounce, rng, n);
+            let reflected =
+                self.trace(&self.mirror_ray(&at, ray), mirror_depth + 1, bounce, rng, n);
             diffuse * (1.0 - material.mirror) + reflected * material.mirror
         } else {
             diffuse
@@ -353,7 +357,12 @@ impl<'a> Tracer<'a> {
                 if q < 1.0 && rng.next_1d() >= q {
                     Vec3::ZERO
                 } else {
-                    let dir = cosine_sample(Vec3::from_array(at.normal), rng);
+                    let dir = cosine_sample(Vec3::from_array(at.shading), rng);
+                    // A direction about the shading normal may point into the surface: the
+                    // path ends there (no light comes from inside).
+                    if self.smooth && !(dir.dot(Vec3::from_array(at.normal)) > 0.0) {
+                        return Vec3::ZERO;
+                    }
                     let origin = Vec3::from_array(offset_origin(Scalar, at, dir.to_array()));
                     n.bounce += 1;
                     self.trace(&Ray::new(origin, dir), mirror_depth, bounce + 1, rng, n) / q
@@ -372,6 +381,7 @@ impl<'a> Tracer<'a> {
             p: p.to_array(),
             err: err.to_array(),
             normal: normal.to_array(),
+            shading: normal.to_array(),
         };
         self.direct_at(&at, n)
     }
@@ -472,19 +482,32 @@ pub struct TileScratch {
     shadows: tile::ShadowScratch,
 }
 
-/// The hit of `ray` on `tri` at `hit`: the tile kernel's [`surface`] at width 1.
-fn surface_of(tri: &Triangle, hit: &Hit, ray: &Ray) -> Surface<f32> {
+/// The hit of `ray` at `hit` in `scene`: the tile kernel's [`surface`] at width 1, with the
+/// scene's shading normal there.
+fn surface_of(scene: &Scene, hit: &Hit, ray: &Ray) -> Surface<f32> {
+    let tri: &Triangle = &scene.triangles()[hit.triangle as usize];
     let v = tri.v.map(|v| v.to_array());
-    surface(Scalar, v, tri.normal.to_array(), hit.b, ray.dir.to_array())
+    let mut at = surface(Scalar, v, tri.normal.to_array(), hit.b, ray.dir.to_array());
+    if let Some(n) = scene.shading_normal(hit.triangle, hit.b) {
+        with_shading(Scalar, &mut at, n.to_array());
+    }
+    at
 }
 
-/// The mirror reflection of `ray` at `at`.
-fn mirror_ray(at: &Surface<f32>, ray: &Ray) -> Ray {
-    let normal = Vec3::from_array(at.normal);
-    let d = ray.dir.normalize();
-    let dir = d - 2.0 * d.dot(normal) * normal;
-    let origin = offset_origin(Scalar, at, dir.to_array());
-    Ray::new(Vec3::from_array(origin), dir)
+impl Tracer<'_> {
+    /// The mirror reflection of `ray` at `at`, about the shading normal; where that would send
+    /// it into the surface (a shading normal tilted from the triangle's), about the triangle's.
+    fn mirror_ray(&self, at: &Surface<f32>, ray: &Ray) -> Ray {
+        let d = ray.dir.normalize();
+        let reflect = |n: Vec3| d - 2.0 * d.dot(n) * n;
+        let normal = Vec3::from_array(at.normal);
+        let mut dir = reflect(Vec3::from_array(at.shading));
+        if self.smooth && !(dir.dot(normal) > 0.0) {
+            dir = reflect(normal);
+        }
+        let origin = offset_origin(Scalar, at, dir.to_array());
+        Ray::new(Vec3::from_array(origin), dir)
+    }
 }
 
 /// A diffuse surface of reflectance `rho` (per channel) under `direct` and `indirect`

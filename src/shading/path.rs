@@ -19,7 +19,7 @@ use glam::{Vec2, Vec3};
 
 use super::lane::Scalar;
 use super::light::{AreaIncident, area_light, directional_light, point_light, spot_light};
-use super::surface::offset_origin;
+use super::surface::{Surface, offset_origin};
 use super::{MIN_SURVIVAL, Mode, ROULETTE_START, RayCounts, SHADOW_EPSILON, Tracer, surface_of};
 use crate::accel::Hit;
 use crate::geometry::{Ray, Triangle};
@@ -193,6 +193,35 @@ impl Tracer<'_> {
         }
     }
 
+    /// The shading frame at `at` (of a triangle with front normal `front`), and the
+    /// direction `toward` the previous vertex in it: about the shading normal turned to the
+    /// front, but about the triangle's own normal where the two normals put that direction on
+    /// different sides (at silhouettes a shading normal can face away from a viewer the
+    /// triangle faces).
+    fn frame(&self, at: &Surface<f32>, front: Vec3, toward: Vec3) -> (ShadingFrame, Vec3) {
+        if self.smooth {
+            let (ng, ns) = (Vec3::from_array(at.normal), Vec3::from_array(at.shading));
+            let n = if ng.dot(front) > 0.0 { ns } else { -ns };
+            let frame = ShadingFrame::from_normal(n);
+            let wo = frame.to_local(toward);
+            if (wo.z > 0.0) == (toward.dot(front) > 0.0) {
+                return (frame, wo);
+            }
+        }
+        let frame = ShadingFrame::from_normal(front);
+        (frame, frame.to_local(toward))
+    }
+
+    /// The BSDF's value for `wo` and `wl` (local; `wi` in the world), zero where the shading
+    /// normal puts `wi` on another side of the triangle (of front normal `front`) than the
+    /// triangle does: light from below a surface does not leak through it.
+    fn f_both_sides(&self, bsdf: &SurfaceBsdf, wo: Vec3, wl: Vec3, wi: Vec3, front: Vec3) -> Vec3 {
+        if self.smooth && (wi.dot(front) > 0.0) != (wl.z > 0.0) {
+            return Vec3::ZERO;
+        }
+        bsdf.f(wo, wl)
+    }
+
     /// One path from the primary `hit` of `ray`: the colour it brings back.
     pub(super) fn path(
         &self,
@@ -208,6 +237,7 @@ impl Tracer<'_> {
         let scene = self.scene;
         let tris = scene.triangles();
         let mis = self.estimator;
+        let smooth = self.smooth;
         let mut colour = Vec3::ZERO;
         let mut beta = Vec3::ONE;
         let (mut ray, mut hit) = (*ray, *hit);
@@ -218,7 +248,7 @@ impl Tracer<'_> {
         for vertex in 0..=bounces + 1 {
             let tri = &tris[hit.triangle as usize];
             let material = &scene.materials()[tri.material as usize];
-            let at = surface_of(tri, &hit, &ray);
+            let at = surface_of(scene, &hit, &ray);
             let p = Vec3::from_array(at.p);
             let e = Tracer::emitted(tri, material, &ray);
             if e != Vec3::ZERO {
@@ -240,8 +270,9 @@ impl Tracer<'_> {
                 break;
             }
             // Glass has air on the front side (local z > 0).
-            let frame = ShadingFrame::from_normal(tri.front());
-            let wo = frame.to_local(-ray.dir.normalize());
+            let front = tri.front();
+            let toward = -ray.dir.normalize();
+            let (frame, wo) = self.frame(&at, front, toward);
             let bsdf = SurfaceBsdf::new(material, scene.base_colour(hit.triangle, hit.b));
             let smooth_only = !bsdf
                 .flags()
@@ -254,12 +285,12 @@ impl Tracer<'_> {
                     if light.power == Vec3::ZERO {
                         continue;
                     }
-                    let inc = point_light(Scalar, light, self.min_r2, &at, true);
+                    let inc = point_light(Scalar, light, self.min_r2, &at, true, smooth);
                     if inc.lit == 0 {
                         continue;
                     }
                     let wi = (light.position - p).normalize();
-                    let f = bsdf.f(wo, frame.to_local(wi));
+                    let f = self.f_both_sides(&bsdf, wo, frame.to_local(wi), wi, front);
                     if f == Vec3::ZERO {
                         continue;
                     }
@@ -279,7 +310,7 @@ impl Tracer<'_> {
                     .iter()
                     .filter(|l| l.irradiance != Vec3::ZERO)
                     .map(|l| {
-                        let inc = directional_light(Scalar, l, self.reach, &at, true);
+                        let inc = directional_light(Scalar, l, self.reach, &at, true, smooth);
                         (-l.direction, inc)
                     });
                 let spots = scene
@@ -287,14 +318,14 @@ impl Tracer<'_> {
                     .iter()
                     .filter(|l| l.power != Vec3::ZERO)
                     .map(|l| {
-                        let inc = spot_light(Scalar, l, self.min_r2, &at, true);
+                        let inc = spot_light(Scalar, l, self.min_r2, &at, true, smooth);
                         ((l.position - p).normalize(), inc)
                     });
                 for (wi, inc) in directional.chain(spots) {
                     if inc.lit == 0 {
                         continue;
                     }
-                    let f = bsdf.f(wo, frame.to_local(wi));
+                    let f = self.f_both_sides(&bsdf, wo, frame.to_local(wi), wi, front);
                     if f == Vec3::ZERO {
                         continue;
                     }
@@ -318,7 +349,7 @@ impl Tracer<'_> {
                     }) = area_light(scene, lights, &at, u_light.0, Vec2::from(u_light.1))
                 {
                     let wl = frame.to_local(wi);
-                    let f = bsdf.f(wo, wl);
+                    let f = self.f_both_sides(&bsdf, wo, wl, wi, front);
                     if f != Vec3::ZERO {
                         n.shadow += 1;
                         if !scene.occluded(&shadow, 1.0 - SHADOW_EPSILON) {
@@ -364,6 +395,11 @@ impl Tracer<'_> {
                 break;
             }
             let wi = frame.to_world(s.wi).normalize();
+            // Where the shading normal sends the path to the other side of the triangle than
+            // its own side says (a tilted shading normal), it ends: light does not leak.
+            if self.smooth && (wi.dot(front) > 0.0) != (s.wi.z > 0.0) {
+                break;
+            }
             let origin = Vec3::from_array(offset_origin(Scalar, &at, wi.to_array()));
             ray = Ray::new(origin, wi);
             if s.flags.is_specular() {

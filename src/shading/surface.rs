@@ -1,5 +1,5 @@
-//! Where a ray hit, in lanes: the hit point and its error bound, the normal on the side the
-//! ray came from, and the origin of a ray leaving it. Written once over [`Lanes`]: one ray at
+//! Where a ray hit, in lanes: the hit point and its error bound, the normals on the side the
+//! ray came from (the triangle's, and the shading normal), and the origin of a ray leaving it. Written once over [`Lanes`]: one ray at
 //! a time is width 1.
 
 use super::lane::{Lanes, each3};
@@ -12,8 +12,12 @@ pub(crate) struct Surface<F> {
     pub p: [F; 3],
     /// Its error bound per axis.
     pub err: [F; 3],
-    /// The unit normal on the side the ray came from (two-sided shading).
+    /// The triangle's unit normal on the side the ray came from (two-sided shading): where
+    /// rays leave from ([`offset_origin`]) and which side a direction is on.
     pub normal: [F; 3],
+    /// The unit shading normal on the same side: the interpolated vertex normal where the
+    /// scene has vertex normals ([`with_shading`]), else `normal`. Cosines and BSDF frames.
+    pub shading: [F; 3],
 }
 
 /// `a·b`, summed x, y, z in that order (glam's `dot`).
@@ -50,11 +54,22 @@ pub(crate) fn surface<S: Lanes>(
     }
     // Two-sided shading: the normal on the side the ray came from.
     let away = s.gt(dot(s, normal, dir), s.splat(0.0));
+    let normal = each3!(|k| s.neg_where(away, normal[k]));
     Surface {
         p,
         err,
-        normal: each3!(|k| s.neg_where(away, normal[k])),
+        normal,
+        shading: normal,
     }
+}
+
+/// `at` with shading normal `n` (unit), turned to the side of `at`'s normal: a vertex normal
+/// that points away from the face the ray sees (the back of a two-sided surface, or a normal
+/// against the winding) is flipped with it.
+#[inline(always)]
+pub(crate) fn with_shading<S: Lanes>(s: S, at: &mut Surface<S::F>, n: [S::F; 3]) {
+    let back = s.lt(dot(s, n, at.normal), s.splat(0.0));
+    at.shading = each3!(|k| s.neg_where(back, n[k]));
 }
 
 /// The origins of rays leaving `at` toward `w`: [`crate::geometry::offset_ray_origin`]'s

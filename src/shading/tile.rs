@@ -11,7 +11,7 @@ use glam::Vec3;
 
 use super::lane::{Lanes, Scalar, each3};
 use super::light::{directional_light, point_light, spot_light};
-use super::surface::{Surface, surface};
+use super::surface::{Surface, surface, with_shading};
 use super::{Mode, RayCounts, SHADOW_EPSILON, Tracer};
 use crate::accel::TILE_RAYS;
 use crate::accel::tri4::Best8;
@@ -54,10 +54,12 @@ impl Default for Gathered {
 /// each vector `[x, y, z]`.
 #[derive(Clone, Debug)]
 pub(crate) struct Points<const B: usize> {
-    /// The hit point, its error bound and the normal facing the ray ([`Surface`]).
+    /// The hit point, its error bound and the normal facing the ray ([`Surface`]), and the
+    /// shading normal (only where the scene has vertex normals).
     p: [[Block; 3]; B],
     err: [[Block; 3]; B],
     normal: [[Block; 3]; B],
+    shading: [[Block; 3]; B],
     /// The sum over the lights so far.
     sum: [[Block; 3]; B],
     /// One light's term, and its shadow ray's origin and direction.
@@ -73,6 +75,7 @@ impl<const B: usize> Default for Points<B> {
             p: zero,
             err: zero,
             normal: zero,
+            shading: zero,
             sum: zero,
             term: zero,
             origin: zero,
@@ -89,19 +92,26 @@ impl<const B: usize> Points<B> {
             p.p[0][k][0] = at.p[k];
             p.err[0][k][0] = at.err[k];
             p.normal[0][k][0] = at.normal[k];
+            p.shading[0][k][0] = at.shading[k];
         }
         p
     }
 
-    /// The [`Surface`] of the pixels from `o`.
+    /// The [`Surface`] of the pixels from `o`; their shading normals stored only if `smooth`
+    /// (else the normals are).
     #[inline(always)]
-    fn surface<S: Lanes>(&self, s: S, o: usize) -> Surface<S::F> {
+    fn surface<S: Lanes>(&self, s: S, o: usize, smooth: bool) -> Surface<S::F> {
         let (c, at) = (o / 8, o % 8);
         let (p, err, normal) = (&self.p[c], &self.err[c], &self.normal[c]);
+        let normal = each3!(|k| s.load_at(&normal[k], at));
         Surface {
             p: each3!(|k| s.load_at(&p[k], at)),
             err: each3!(|k| s.load_at(&err[k], at)),
-            normal: each3!(|k| s.load_at(&normal[k], at)),
+            normal,
+            shading: match smooth {
+                true => each3!(|k| s.load_at(&self.shading[c][k], at)),
+                false => normal,
+            },
         }
     }
 
@@ -325,8 +335,22 @@ impl Tracer<'_> {
                 false => s.gather(|l| dirs[a][g.idx[o + l] as usize]),
             });
             let b = each3!(|a| s.load(block(&g.b[a], o)));
-            let at = surface(s, v, normal, b, dir);
+            let mut at = surface(s, v, normal, b, dir);
             let (bi, ai) = (o / 8, o % 8);
+            if self.smooth {
+                // Each pixel's interpolated vertex normal (the triangle's where it has none).
+                let ns: [Vec3; 8] = std::array::from_fn(|l| {
+                    let j = o + l.min(w - 1);
+                    let b = [g.b[0][j], g.b[1][j], g.b[2][j]];
+                    let t = g.tri[j];
+                    self.scene
+                        .shading_normal(t, b)
+                        .unwrap_or(tris[t as usize].normal)
+                });
+                with_shading(s, &mut at, each3!(|a| s.gather(|l| ns[l][a])));
+                let sh = &mut pts.shading[bi];
+                each3!(|a| s.store_at(&mut sh[a], ai, at.shading[a]));
+            }
             let (p, err, nn) = (&mut pts.p[bi], &mut pts.err[bi], &mut pts.normal[bi]);
             each3!(|a| {
                 s.store_at(&mut p[a], ai, at.p[a]);
@@ -492,14 +516,16 @@ impl Tracer<'_> {
         let (mut lit, mut traced) = (0u64, 0u64);
         for c in 0..chunks {
             let o = c * w;
-            let at = pts.surface(s, o);
+            let at = pts.surface(s, o, self.smooth);
             // (A match, not a closure: a closure would not be compiled with the kernel's
             // target features, and the lane functions would not inline into it.)
-            let shadows_on = self.settings.effects.shadows;
+            let (shadows_on, smooth) = (self.settings.effects.shadows, self.smooth);
             let inc = match light {
-                Delta::Point(l) => point_light(s, l, self.min_r2, &at, shadows_on),
-                Delta::Directional(l) => directional_light(s, l, self.reach, &at, shadows_on),
-                Delta::Spot(l) => spot_light(s, l, self.min_r2, &at, shadows_on),
+                Delta::Point(l) => point_light(s, l, self.min_r2, &at, shadows_on, smooth),
+                Delta::Directional(l) => {
+                    directional_light(s, l, self.reach, &at, shadows_on, smooth)
+                }
+                Delta::Spot(l) => spot_light(s, l, self.min_r2, &at, shadows_on, smooth),
             };
             let (bi, ai) = (o / 8, o % 8);
             let (term, origin, dir) = (&mut pts.term[bi], &mut pts.origin[bi], &mut pts.dir[bi]);
