@@ -2,7 +2,10 @@
 //! manner of SVGF (Schied et al. 2017), run on the indirect irradiance alone.
 //!
 //! The direct light of a point light is exact per pixel (one shadow ray), so only the indirect
-//! term is noisy, and on diffuse walls that term is smooth. The render splits every sample
+//! term is noisy, and on diffuse walls that term is smooth. In the physically based path an
+//! area light's direct light is noisy too (one point on the light a sample): it goes with the
+//! indirect light where the first hit is diffuse; a mirror, metal or glass first hit is not
+//! filtered. The render splits every sample
 //! ([`crate::shading::SplitSample`]) and sums the parts into [`Guides`]; the filter divides the
 //! indirect light by the albedo (so texture and colour edges are not blurred), smooths that
 //! irradiance over neighbours on the same surface, and multiplies the albedo back. Neighbours

@@ -123,7 +123,7 @@ impl<'a> Tracer<'a> {
             return self.background;
         };
         let c = if self.physical() {
-            self.path(ray, &hit, rng, n)
+            self.path(ray, &hit, rng, n).sum()
         } else {
             self.shade(ray, &hit, 0, 0, rng, n)
         };
@@ -199,16 +199,45 @@ impl<'a> Tracer<'a> {
         let at = surface_of(self.scene, hit, ray);
         let (p, normal) = (Vec3::from_array(at.p), Vec3::from_array(at.normal));
         if self.physical() {
-            // Not split yet: the whole path is left to the denoiser's `rest`.
+            let c = self.path(ray, hit, rng, n);
+            let guide = Some(GuideHit {
+                position: p,
+                normal,
+                object: self.scene.object_of(hit.triangle),
+                reflections: mirror_depth,
+            });
+            // A first hit that only scatters diffusely: the light its path brings besides what
+            // the first vertex gives exactly is its colour times an irradiance, which the
+            // denoiser filters (soft shadows and bounces alike). A mirror, metal or glass
+            // first hit keeps all its light as it is: a filter on the surface would blur what
+            // it reflects.
+            if material.mirror > 0.0 || material.metal > 0.0 || material.transmission > 0.0 {
+                return SplitSample {
+                    rest: c.sum(),
+                    guide,
+                    ..SplitSample::default()
+                };
+            }
+            let albedo = self.scene.base_colour(hit.triangle, hit.b);
+            // Per channel: a black channel (which a diffuse surface brings no light in) keeps
+            // whatever it has apart.
+            let part = |exact: f32, traced: f32, a: f32| {
+                if a > 0.0 {
+                    (exact, traced / a)
+                } else {
+                    (exact + traced, 0.0)
+                }
+            };
+            let (x, y, z) = (
+                part(c.exact.x, c.traced.x, albedo.x),
+                part(c.exact.y, c.traced.y, albedo.y),
+                part(c.exact.z, c.traced.z, albedo.z),
+            );
             return SplitSample {
-                rest: self.path(ray, hit, rng, n),
-                guide: Some(GuideHit {
-                    position: p,
-                    normal,
-                    object: self.scene.object_of(hit.triangle),
-                    reflections: mirror_depth,
-                }),
-                ..SplitSample::default()
+                rest: Vec3::new(x.0, y.0, z.0),
+                albedo,
+                irradiance: Vec3::new(x.1, y.1, z.1),
+                guide,
             };
         }
         let colour = self.scene.base_colour(hit.triangle, hit.b);

@@ -222,14 +222,14 @@ impl Tracer<'_> {
         bsdf.f(wo, wl)
     }
 
-    /// One path from the primary `hit` of `ray`: the colour it brings back.
+    /// One path from the primary `hit` of `ray`: the colour it brings back, in two parts.
     pub(super) fn path(
         &self,
         ray: &Ray,
         hit: &Hit,
         rng: &mut impl SampleSource,
         n: &mut RayCounts,
-    ) -> Vec3 {
+    ) -> PathColour {
         let bounces = match self.settings.effects.indirect {
             Indirect::PathTraced { bounces } => bounces,
             _ => 0,
@@ -238,7 +238,8 @@ impl Tracer<'_> {
         let tris = scene.triangles();
         let mis = self.estimator;
         let smooth = self.smooth;
-        let mut colour = Vec3::ZERO;
+        // [what the first vertex gives exactly, the rest] (see `PathColour`).
+        let mut colour = [Vec3::ZERO; 2];
         let mut beta = Vec3::ONE;
         let (mut ray, mut hit) = (*ray, *hit);
         let mut came = Came {
@@ -246,6 +247,8 @@ impl Tracer<'_> {
             pdf: None,
         };
         for vertex in 0..=bounces + 1 {
+            // Where this vertex's emission and delta lights go.
+            let exact = usize::from(vertex > 0);
             let tri = &tris[hit.triangle as usize];
             let material = &scene.materials()[tri.material as usize];
             let at = surface_of(scene, &hit, &ray);
@@ -264,7 +267,7 @@ impl Tracer<'_> {
                         power_heuristic(pb, pl)
                     }
                 };
-                colour += beta * e * w;
+                colour[exact] += beta * e * w;
             }
             if vertex > bounces {
                 break;
@@ -302,7 +305,7 @@ impl Tracer<'_> {
                             continue;
                         }
                     }
-                    colour += beta * f * Vec3::from_array(inc.term) * PI;
+                    colour[exact] += beta * f * Vec3::from_array(inc.term) * PI;
                 }
                 // Directional and spot lights: exact, as the point lights.
                 let directional = scene
@@ -337,7 +340,7 @@ impl Tracer<'_> {
                             continue;
                         }
                     }
-                    colour += beta * f * Vec3::from_array(inc.term) * PI;
+                    colour[exact] += beta * f * Vec3::from_array(inc.term) * PI;
                 }
                 if mis != Estimator::Bsdf
                     && let Some(lights) = scene.area_lights()
@@ -358,7 +361,7 @@ impl Tracer<'_> {
                             } else {
                                 1.0
                             };
-                            colour += beta * f * emission * (wl.z.abs() * w / pdf);
+                            colour[1] += beta * f * emission * (wl.z.abs() * w / pdf);
                         }
                     }
                 }
@@ -417,17 +420,39 @@ impl Tracer<'_> {
                     // The environment, found by BSDF sampling alone (counted whole): under a
                     // constant sky the BSDF's own sampling draws `f·cos` as well as any light
                     // sampling could, and costs no shadow ray.
-                    colour += beta * self.background;
+                    colour[1] += beta * self.background;
                     break;
                 }
             }
         }
-        debug_assert!(colour.is_finite(), "non-finite colour {colour}");
-        if colour.is_finite() {
-            colour
+        let [exact, traced] = colour;
+        debug_assert!(
+            exact.is_finite() && traced.is_finite(),
+            "non-finite colour {exact} + {traced}"
+        );
+        if exact.is_finite() && traced.is_finite() {
+            PathColour { exact, traced }
         } else {
-            Vec3::ZERO
+            PathColour::default()
         }
+    }
+}
+
+/// A path's colour in two parts, for the denoiser: what its first vertex gives exactly (the
+/// emitter the camera sees, the point, directional and spot lights there: no random number
+/// decides them) and the rest (area lights, bounces, the environment: the noisy part).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct PathColour {
+    /// The first vertex's emission and delta lights.
+    pub(super) exact: Vec3,
+    /// The rest.
+    pub(super) traced: Vec3,
+}
+
+impl PathColour {
+    /// The whole colour.
+    pub(super) fn sum(self) -> Vec3 {
+        self.exact + self.traced
     }
 }
 

@@ -4,9 +4,10 @@
 use glam::Vec3;
 
 /// One sample of a pixel split for the denoiser: its colour is `rest + albedo·irradiance`.
-/// `irradiance` is the noisy path-traced indirect irradiance at the pixel's guide vertex,
-/// demodulated (not yet multiplied by any reflectance); everything else, above all the exact
-/// direct light and its hard shadows, is in `rest`.
+/// `irradiance` is the noisy path-traced irradiance at the pixel's guide vertex, demodulated
+/// (not yet multiplied by any reflectance): the indirect light, and in the physically based
+/// path an area light's direct light too; everything else, above all the exact direct light of
+/// point lights and its hard shadows, is in `rest`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SplitSample {
     /// What the denoiser leaves alone.

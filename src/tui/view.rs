@@ -502,8 +502,9 @@ impl Screen {
         // The price, live: the time spent on this image and its error estimated from the
         // per-pixel variance (denoised: the noise left after the filter, then the raw one's).
         let (raw, shown) = self.error;
-        // The physically based path's light is not in the denoiser's guides yet (it is neither
-        // filtered nor in the variance estimate): its frames show the time alone.
+        // The physically based path's variance estimate covers only what the denoiser filters
+        // (the light of diffuse first hits), not the light of mirror, metal and glass ones: its
+        // frames show the time alone.
         let unguided = gi && raytty::shading::PathEffects::of(&app.scene).any();
         let price = if !gi {
             String::new()
@@ -514,7 +515,7 @@ impl Screen {
         } else {
             format!("{:.2}s ±{raw:.4}", self.spent.as_secs_f64())
         };
-        let filter = match (gi && !unguided, app.denoise) {
+        let filter = match (gi, app.denoise) {
             (false, _) => String::new(),
             (true, true) => "N:denoised".to_string(),
             (true, false) => "N:raw".to_string(),
