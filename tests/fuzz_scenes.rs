@@ -10,9 +10,9 @@
 //!
 //! `cargo test` runs the regression corpus in `tests/fuzz_corpus/` (hostile inputs: files
 //! named `ok_*.toml` must load, every other `.toml` must be refused with a position) and a
-//! short run; the long run is ignored:
+//! short run; the long run, a million inputs per parser, is ignored:
 //!
-//!     RAYTTY_FUZZ_ITERATIONS=200000 RAYTTY_FUZZ_SEED=1 cargo test --test fuzz_scenes -- --ignored
+//!     cargo test --release --test fuzz_scenes -- --ignored --nocapture
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
@@ -453,40 +453,6 @@ fn short_run() {
     assert!(t.loaded > 0 && t.errors > 0, "{t:?}");
 }
 
-/// The long run: `RAYTTY_FUZZ_ITERATIONS` inputs (default 20000) from `RAYTTY_FUZZ_SEED`.
-#[test]
-#[ignore]
-fn long_run() {
-    let var = |name: &str, default: u64| {
-        std::env::var(name)
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(default)
-    };
-    let (n, seed) = (
-        var("RAYTTY_FUZZ_ITERATIONS", 20_000),
-        var("RAYTTY_FUZZ_SEED", 1),
-    );
-    let start = Instant::now();
-    let t = run(n, seed);
-    eprintln!(
-        "fuzz: {} inputs from seed {seed} in {:.1?}: {} loaded, {} rejected with a position; slowest input {:.1?}",
-        t.inputs,
-        start.elapsed(),
-        t.loaded,
-        t.errors,
-        t.slowest
-    );
-    eprintln!("the slowest input:\n{}", t.slowest_input);
-    let start = Instant::now();
-    let (loaded, refused) = run_generated(n / 10, seed);
-    eprintln!(
-        "generated: {} scenes from seed {seed} in {:.1?}: {loaded} loaded and {refused} refused, each as its values said",
-        n / 10,
-        start.elapsed()
-    );
-}
-
 // Model files: the same mutations over the small models in `tests/models/` (text formats as
 // text; binary ones byte by byte, with 32-bit counts and offsets overwritten by hostile
 // values). Every input must load into a scene that renders a finite frame, or be refused with
@@ -496,25 +462,88 @@ mod models {
     use super::*;
     use raytty::scene::model::{self, Format, View};
 
-    /// The seed models: (name, format, bytes). The OBJ reads `cube.mtl` (mutated too).
-    fn seeds() -> Vec<(&'static str, Format, Vec<u8>)> {
+    /// A parser the long run fuzzes on its own, with the models it starts from.
+    #[derive(Clone, Copy, Debug)]
+    pub(super) enum Parser {
+        /// OBJ (its MTL kept valid).
+        Obj,
+        /// MTL (its OBJ kept valid).
+        Mtl,
+        /// glTF JSON with embedded buffers.
+        GltfJson,
+        /// GLB: the header, the JSON chunk and the binary chunk.
+        Glb,
+        /// PLY, ASCII: header and body.
+        PlyAscii,
+        /// PLY, binary little-endian: header and body.
+        PlyBinary,
+        /// STL, ASCII.
+        StlAscii,
+        /// STL, binary.
+        StlBinary,
+    }
+
+    impl Parser {
+        pub(super) const ALL: [Parser; 8] = [
+            Parser::Obj,
+            Parser::Mtl,
+            Parser::GltfJson,
+            Parser::Glb,
+            Parser::PlyAscii,
+            Parser::PlyBinary,
+            Parser::StlAscii,
+            Parser::StlBinary,
+        ];
+
+        /// The seed files: models, and for OBJ and MTL the material library each one reads.
+        fn files(self) -> &'static [(&'static str, &'static str)] {
+            match self {
+                Parser::Obj | Parser::Mtl => &[("cube.obj", "cube.mtl"), ("lamp.obj", "lamp.mtl")],
+                Parser::GltfJson => &[("two_nodes.gltf", ""), ("lamp.gltf", "")],
+                Parser::Glb => &[("cube.glb", ""), ("checker.glb", "")],
+                Parser::PlyAscii => &[("cube.ply", "")],
+                Parser::PlyBinary => &[("cube_binary.ply", "")],
+                Parser::StlAscii => &[("cube.stl", "")],
+                Parser::StlBinary => &[("cube_binary.stl", "")],
+            }
+        }
+
+        /// Whether the mutated file is text (mutated as text half of the time).
+        fn text(self) -> bool {
+            matches!(
+                self,
+                Parser::Obj | Parser::Mtl | Parser::GltfJson | Parser::PlyAscii | Parser::StlAscii
+            )
+        }
+    }
+
+    /// A seed model: its name, format, bytes, and its MTL's name and bytes (empty if none).
+    struct Seed {
+        name: &'static str,
+        format: Format,
+        bytes: Vec<u8>,
+        mtl_name: &'static str,
+        mtl: Vec<u8>,
+    }
+
+    fn seeds(parser: Parser) -> Vec<Seed> {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/models");
-        [
-            "cube.obj",
-            "cube.ply",
-            "cube_binary.ply",
-            "cube.stl",
-            "cube_binary.stl",
-            "two_nodes.gltf",
-            "cube.glb",
-            "checker.glb",
-        ]
-        .into_iter()
-        .map(|n| {
-            let path = dir.join(n);
-            (n, Format::of(&path).unwrap(), std::fs::read(&path).unwrap())
-        })
-        .collect()
+        let read = |n: &str| std::fs::read(dir.join(n)).unwrap();
+        parser
+            .files()
+            .iter()
+            .map(|&(name, mtl_name)| Seed {
+                name,
+                format: Format::of(Path::new(name)).unwrap(),
+                bytes: read(name),
+                mtl_name,
+                mtl: if mtl_name.is_empty() {
+                    Vec::new()
+                } else {
+                    read(mtl_name)
+                },
+            })
+            .collect()
     }
 
     fn mtl() -> Vec<u8> {
@@ -562,12 +591,19 @@ mod models {
         b
     }
 
-    /// Loads `bytes` as a model of `format` (its MTL `mtl`) and checks the outcome; panics on
-    /// a finding. Returns whether it loaded.
-    fn check(name: &str, format: Format, bytes: &[u8], mtl: &[u8]) -> bool {
+    /// Loads `bytes` as a model of `format` (the file `mtl_name` reads as `mtl`) and checks
+    /// the outcome; panics on a finding. A model that loaded is rendered if `render`. Returns
+    /// whether it loaded.
+    fn check(
+        name: &str,
+        format: Format,
+        bytes: &[u8],
+        (mtl_name, mtl): (&str, &[u8]),
+        render: bool,
+    ) -> bool {
         let read = |p: &str| {
-            if p == "cube.mtl" {
-                Ok(("cube.mtl".to_string(), mtl.to_vec()))
+            if p == mtl_name {
+                Ok((mtl_name.to_string(), mtl.to_vec()))
             } else {
                 Err(format!("cannot read {p}: no such file"))
             }
@@ -575,7 +611,7 @@ mod models {
         let outcome = catch_unwind(AssertUnwindSafe(|| {
             let loaded = model::parse(format, bytes, name, &read)
                 .and_then(|m| m.into_scene(name, "fuzz", &View::default()));
-            if let Ok(l) = &loaded {
+            if let (Ok(l), true) = (&loaded, render) {
                 let s = &l.scene;
                 let settings = Stage::Indirect.settings(s.effects());
                 let frame = s.render(&Options {
@@ -610,29 +646,27 @@ mod models {
         }
     }
 
-    pub(super) fn run(iterations: u64, seed: u64) -> (u64, u64) {
-        let seeds = seeds();
-        let mtl = mtl();
+    /// Feeds `parser` `iterations` mutated inputs from `seed`, rendering one loaded model in
+    /// `render_every`; returns how many loaded and how many were refused.
+    pub(super) fn run(parser: Parser, iterations: u64, seed: u64, render_every: u64) -> (u64, u64) {
+        let seeds = seeds(parser);
         let mut rng = Rng::seeded(seed);
         let (mut loaded, mut refused) = (0, 0);
         for i in 0..iterations {
-            let (name, format, base) = &seeds[(i % seeds.len() as u64) as usize];
-            let text = !matches!(
-                *name,
-                "cube_binary.ply" | "cube_binary.stl" | "cube.glb" | "checker.glb"
-            );
+            let s = &seeds[(i % seeds.len() as u64) as usize];
             let mutated = |rng: &mut Rng, b: &[u8]| {
-                if text && rng.next_u64().is_multiple_of(2) {
+                if parser.text() && rng.next_u64().is_multiple_of(2) {
                     super::mutate(rng, &String::from_utf8_lossy(b)).into_bytes()
                 } else {
                     mutate_bytes(rng, b)
                 }
             };
-            let (bytes, mtl) = match (format, rng.next_u64() % 4) {
-                (Format::Obj, 0) => (base.clone(), mutated(&mut rng, &mtl)),
-                _ => (mutated(&mut rng, base), mtl.clone()),
+            let (bytes, mtl) = match parser {
+                Parser::Mtl => (s.bytes.clone(), mutated(&mut rng, &s.mtl)),
+                _ => (mutated(&mut rng, &s.bytes), s.mtl.clone()),
             };
-            if check(name, *format, &bytes, &mtl) {
+            let render = i.is_multiple_of(render_every);
+            if check(s.name, s.format, &bytes, (s.mtl_name, &mtl), render) {
                 loaded += 1;
             } else {
                 refused += 1;
@@ -643,8 +677,11 @@ mod models {
 
     #[test]
     fn every_seed_model_loads() {
-        for (name, format, bytes) in seeds() {
-            assert!(check(name, format, &bytes, &mtl()), "{name}");
+        for parser in Parser::ALL {
+            for s in seeds(parser) {
+                let mtl = (s.mtl_name, s.mtl.as_slice());
+                assert!(check(s.name, s.format, &s.bytes, mtl, true), "{}", s.name);
+            }
         }
     }
 
@@ -661,41 +698,78 @@ mod models {
             n += 1;
             let name = path.file_name().unwrap().to_string_lossy().into_owned();
             let bytes = std::fs::read(&path).unwrap();
-            let loaded = check(&name, format, &bytes, &mtl());
+            let loaded = check(&name, format, &bytes, ("cube.mtl", &mtl()), true);
             assert_eq!(loaded, name.starts_with("ok_"), "{name}");
         }
         assert!(n >= 8, "the corpus has {n} model files");
     }
 
-    /// A short run in every `cargo test`.
+    /// A short run in every `cargo test`: a hundred inputs a parser, each model that loads
+    /// rendered.
     #[test]
     fn short_model_run() {
-        let (loaded, refused) = run(700, 11);
-        assert!(
-            loaded > 0 && refused > 0,
-            "{loaded} loaded, {refused} refused"
-        );
+        for parser in Parser::ALL {
+            let (loaded, refused) = run(parser, 100, 11, 1);
+            assert_eq!(loaded + refused, 100);
+            assert!(
+                refused > 0,
+                "{parser:?}: {loaded} loaded, {refused} refused"
+            );
+        }
     }
+}
 
-    /// The long run over models: `RAYTTY_FUZZ_ITERATIONS` inputs from `RAYTTY_FUZZ_SEED`.
-    #[test]
-    #[ignore]
-    fn long_model_run() {
-        let var = |name: &str, default: u64| {
-            std::env::var(name)
-                .ok()
-                .and_then(|v| v.parse().ok())
-                .unwrap_or(default)
-        };
-        let (n, seed) = (
-            var("RAYTTY_FUZZ_ITERATIONS", 20_000),
-            var("RAYTTY_FUZZ_SEED", 1),
-        );
-        let start = Instant::now();
-        let (loaded, refused) = run(n, seed);
-        eprintln!(
-            "models: {n} inputs from seed {seed} in {:.1?}: {loaded} loaded, {refused} refused",
-            start.elapsed()
-        );
-    }
+/// The long run: `RAYTTY_FUZZ_ITERATIONS` inputs (default a million) from `RAYTTY_FUZZ_SEED`
+/// for each parser, the parsers in parallel threads: mutated scene files (with their OBJ
+/// mesh), generated scene files, and each model parser on its own. Every loaded scene file
+/// is rendered, and one loaded model in `RAYTTY_FUZZ_RENDER_EVERY` (default 100: the
+/// render, not the parser, would take most of the time).
+///
+///     cargo test --release --test fuzz_scenes -- --ignored --nocapture
+#[test]
+#[ignore]
+fn million_per_parser() {
+    let var = |name: &str, default: u64| {
+        std::env::var(name)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(default)
+    };
+    let (n, seed) = (
+        var("RAYTTY_FUZZ_ITERATIONS", 1_000_000),
+        var("RAYTTY_FUZZ_SEED", 1),
+    );
+    let render_every = var("RAYTTY_FUZZ_RENDER_EVERY", 100).max(1);
+    let start = Instant::now();
+    std::thread::scope(|scope| {
+        scope.spawn(|| {
+            let t = run(n, seed);
+            eprintln!(
+                "scene TOML: {} inputs from seed {seed} in {:.1?}: {} loaded, {} refused with a position; slowest input {:.1?}",
+                t.inputs,
+                start.elapsed(),
+                t.loaded,
+                t.errors,
+                t.slowest
+            );
+            eprintln!("the slowest scene input:\n{}", t.slowest_input);
+        });
+        scope.spawn(|| {
+            let (loaded, refused) = run_generated(n, seed);
+            eprintln!(
+                "generated scene TOML: {n} inputs from seed {seed} in {:.1?}: {loaded} loaded and {refused} refused, each as its values said",
+                start.elapsed()
+            );
+        });
+        for parser in models::Parser::ALL {
+            scope.spawn(move || {
+                let (loaded, refused) = models::run(parser, n, seed, render_every);
+                eprintln!(
+                    "{parser:?}: {n} inputs from seed {seed} in {:.1?}: {loaded} loaded, {refused} refused",
+                    start.elapsed()
+                );
+            });
+        }
+    });
+    eprintln!("all parsers: {:.1?}, no panic", start.elapsed());
 }

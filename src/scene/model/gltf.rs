@@ -38,9 +38,25 @@ const MAX_DEPTH: usize = 256;
 /// Most node instances visited (a node shared by many parents is visited once per parent).
 const MAX_NODE_VISITS: usize = 1_000_000;
 
+/// Bytes in a GLB's header: magic, version, length.
+const GLB_HEADER: u32 = 12;
+
+/// The length a GLB's header declares, if `bytes` start with one.
+fn glb_length(bytes: &[u8]) -> Option<u32> {
+    let length = bytes.strip_prefix(b"glTF")?.get(4..8)?;
+    Some(u32::from_le_bytes(length.try_into().ok()?))
+}
+
 /// Reads `bytes` (a `.gltf` or `.glb`) as a model named `file`, its buffers through `read`.
 pub fn parse(bytes: &[u8], file: &str, read: FileReader) -> Result<Model, SceneFileError> {
     let whole = |m: String| SceneFileError::whole_file(file, m);
+    // gltf 1.4.1 subtracts the 12-byte header from a GLB's declared length unchecked (an
+    // overflow panic where overflow is checked: found by the million-input fuzz run).
+    if let Some(length) = glb_length(bytes).filter(|&l| l < GLB_HEADER) {
+        return Err(whole(format!(
+            "byte 8: the GLB's length is {length}, less than its own {GLB_HEADER}-byte header"
+        )));
+    }
     let gltf = match Gltf::from_slice_without_validation(bytes) {
         Ok(g) => g,
         Err(e) => return Err(parse_error(bytes, file, e)),

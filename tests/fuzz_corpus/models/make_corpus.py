@@ -44,6 +44,8 @@ g("huge_count_no_view.gltf", lambda d: (d["accessors"][0].pop("bufferView"), d["
 g("exponential_instances.gltf", exponential)
 w("not_json.gltf", "{\"asset\": {\"version\": \"2.0\"},\n  \"nodes\": [ oops ]\n}")
 w("bad_glb_length.glb", b"glTF" + struct.pack("<II", 2, 0xffffff) + struct.pack("<II", 0xfffff0, 0x4E4F534A) + b"{}  ")
+# Found by the million-input run: a GLB length below the header (gltf 1.4.1 subtracts unchecked).
+w("glb_length_below_header.glb", b"glTF" + struct.pack("<II", 2, 3) + struct.pack("<II", 0x5e0, 0x4E4F534A) + b"{\"asset\": {\"version\": \"2.0\"}}")
 # Found by fuzzing: no accessors at all, while a primitive names POSITION 0 (gltf-json 1.4.1's
 # validator indexed the accessors unchecked and panicked).
 g("position_accessor_missing.gltf", lambda d: d.update({"accessors": []}))
