@@ -5,7 +5,7 @@
 //! term is noisy, and on diffuse walls that term is smooth. In the physically based path an
 //! area light's direct light is noisy too (one point on the light a sample): it goes with the
 //! indirect light where the first hit is diffuse; a mirror, metal or glass first hit is not
-//! filtered. The render splits every sample
+//! filtered, nor is light focused by glass or metal after the first hit (caustics). The render splits every sample
 //! ([`crate::shading::SplitSample`]) and sums the parts into [`Guides`]; the filter divides the
 //! indirect light by the albedo (so texture and colour edges are not blurred), smooths that
 //! irradiance over neighbours on the same surface, and multiplies the albedo back. Neighbours

@@ -206,11 +206,10 @@ impl<'a> Tracer<'a> {
                 object: self.scene.object_of(hit.triangle),
                 reflections: mirror_depth,
             });
-            // A first hit that only scatters diffusely: the light its path brings besides what
-            // the first vertex gives exactly is its colour times an irradiance, which the
-            // denoiser filters (soft shadows and bounces alike). A mirror, metal or glass
-            // first hit keeps all its light as it is: a filter on the surface would blur what
-            // it reflects.
+            // A first hit that only scatters diffusely: the soft part of the light its path
+            // brings is its colour times an irradiance, which the denoiser filters (soft
+            // shadows and bounces alike). A mirror, metal or glass first hit keeps all its
+            // light as it is: a filter on the surface would blur what it reflects.
             if material.mirror > 0.0 || material.metal > 0.0 || material.transmission > 0.0 {
                 return SplitSample {
                     rest: c.sum(),
@@ -221,17 +220,17 @@ impl<'a> Tracer<'a> {
             let albedo = self.scene.base_colour(hit.triangle, hit.b);
             // Per channel: a black channel (which a diffuse surface brings no light in) keeps
             // whatever it has apart.
-            let part = |exact: f32, traced: f32, a: f32| {
+            let part = |sharp: f32, soft: f32, a: f32| {
                 if a > 0.0 {
-                    (exact, traced / a)
+                    (sharp, soft / a)
                 } else {
-                    (exact + traced, 0.0)
+                    (sharp + soft, 0.0)
                 }
             };
             let (x, y, z) = (
-                part(c.exact.x, c.traced.x, albedo.x),
-                part(c.exact.y, c.traced.y, albedo.y),
-                part(c.exact.z, c.traced.z, albedo.z),
+                part(c.sharp.x, c.soft.x, albedo.x),
+                part(c.sharp.y, c.soft.y, albedo.y),
+                part(c.sharp.z, c.soft.z, albedo.z),
             );
             return SplitSample {
                 rest: Vec3::new(x.0, y.0, z.0),

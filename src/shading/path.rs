@@ -238,8 +238,11 @@ impl Tracer<'_> {
         let tris = scene.triangles();
         let mis = self.estimator;
         let smooth = self.smooth;
-        // [what the first vertex gives exactly, the rest] (see `PathColour`).
+        // [sharp, soft] (see `PathColour`).
         let mut colour = [Vec3::ZERO; 2];
+        // Whether the path has been focused (a glossy or specular bounce past the first
+        // vertex): what it brings from then on is sharp.
+        let mut focused = false;
         let mut beta = Vec3::ONE;
         let (mut ray, mut hit) = (*ray, *hit);
         let mut came = Came {
@@ -247,8 +250,10 @@ impl Tracer<'_> {
             pdf: None,
         };
         for vertex in 0..=bounces + 1 {
-            // Where this vertex's emission and delta lights go.
-            let exact = usize::from(vertex > 0);
+            // Where this vertex's area light and what escapes from it go, and its emission and
+            // delta lights (the first vertex's are exact: sharp).
+            let soft = usize::from(!focused);
+            let exact = if vertex == 0 { 0 } else { soft };
             let tri = &tris[hit.triangle as usize];
             let material = &scene.materials()[tri.material as usize];
             let at = surface_of(scene, &hit, &ray);
@@ -361,7 +366,7 @@ impl Tracer<'_> {
                             } else {
                                 1.0
                             };
-                            colour[1] += beta * f * emission * (wl.z.abs() * w / pdf);
+                            colour[soft] += beta * f * emission * (wl.z.abs() * w / pdf);
                         }
                     }
                 }
@@ -410,6 +415,7 @@ impl Tracer<'_> {
             } else {
                 n.bounce += 1;
             }
+            focused |= vertex > 0 && !s.flags.contains(BsdfFlags::DIFFUSE);
             came = Came {
                 from: p,
                 pdf: (!s.flags.is_specular()).then_some(s.pdf),
@@ -420,39 +426,41 @@ impl Tracer<'_> {
                     // The environment, found by BSDF sampling alone (counted whole): under a
                     // constant sky the BSDF's own sampling draws `f·cos` as well as any light
                     // sampling could, and costs no shadow ray.
-                    colour[1] += beta * self.background;
+                    colour[soft] += beta * self.background;
                     break;
                 }
             }
         }
-        let [exact, traced] = colour;
+        let [sharp, soft] = colour;
         debug_assert!(
-            exact.is_finite() && traced.is_finite(),
-            "non-finite colour {exact} + {traced}"
+            sharp.is_finite() && soft.is_finite(),
+            "non-finite colour {sharp} + {soft}"
         );
-        if exact.is_finite() && traced.is_finite() {
-            PathColour { exact, traced }
+        if sharp.is_finite() && soft.is_finite() {
+            PathColour { sharp, soft }
         } else {
             PathColour::default()
         }
     }
 }
 
-/// A path's colour in two parts, for the denoiser: what its first vertex gives exactly (the
-/// emitter the camera sees, the point, directional and spot lights there: no random number
-/// decides them) and the rest (area lights, bounces, the environment: the noisy part).
+/// A path's colour in two parts, for the denoiser: the sharp part, which a filter must leave
+/// as it is (what the first vertex gives exactly: the emitter the camera sees, the point,
+/// directional and spot lights there; and the light of a path focused by a glossy or specular
+/// bounce past the first vertex: caustics, which a filter would spread), and the soft part
+/// (area lights, diffuse bounces, the environment: noisy, but smooth across a surface).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(super) struct PathColour {
-    /// The first vertex's emission and delta lights.
-    pub(super) exact: Vec3,
-    /// The rest.
-    pub(super) traced: Vec3,
+    /// What a filter must leave as it is.
+    pub(super) sharp: Vec3,
+    /// The diffusely gathered rest.
+    pub(super) soft: Vec3,
 }
 
 impl PathColour {
     /// The whole colour.
     pub(super) fn sum(self) -> Vec3 {
-        self.exact + self.traced
+        self.sharp + self.soft
     }
 }
 
