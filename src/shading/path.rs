@@ -288,31 +288,16 @@ impl Tracer<'_> {
             let u_light = (rng.next_1d(), rng.next_2d());
             let u_bsdf = (rng.next_1d(), rng.next_2d());
             if !smooth_only {
-                // Point lights: exact, as the seed's (π·f times its irradiance term).
-                for light in self.lights {
-                    if light.power == Vec3::ZERO {
-                        continue;
-                    }
-                    let inc = point_light(Scalar, light, self.min_r2, &at, true, smooth);
-                    if inc.lit == 0 {
-                        continue;
-                    }
-                    let wi = (light.position - p).normalize();
-                    let f = self.f_both_sides(&bsdf, wo, frame.to_local(wi), wi, front);
-                    if f == Vec3::ZERO {
-                        continue;
-                    }
-                    if inc.traced != 0 {
-                        n.shadow += 1;
-                        let shadow =
-                            Ray::new(Vec3::from_array(inc.origin), Vec3::from_array(inc.dir));
-                        if scene.occluded(&shadow, 1.0 - SHADOW_EPSILON) {
-                            continue;
-                        }
-                    }
-                    colour[exact] += beta * f * Vec3::from_array(inc.term) * PI;
-                }
-                // Directional and spot lights: exact, as the point lights.
+                // Point, directional and spot lights: exact, as the seed's (π·f times the
+                // light's irradiance term), one shadow ray each.
+                let points = self
+                    .lights
+                    .iter()
+                    .filter(|l| l.power != Vec3::ZERO)
+                    .map(|l| {
+                        let inc = point_light(Scalar, l, self.min_r2, &at, true, smooth);
+                        ((l.position - p).normalize(), inc)
+                    });
                 let directional = scene
                     .directional_lights()
                     .iter()
@@ -329,7 +314,7 @@ impl Tracer<'_> {
                         let inc = spot_light(Scalar, l, self.min_r2, &at, true, smooth);
                         ((l.position - p).normalize(), inc)
                     });
-                for (wi, inc) in directional.chain(spots) {
+                for (wi, inc) in points.chain(directional).chain(spots) {
                     if inc.lit == 0 {
                         continue;
                     }
