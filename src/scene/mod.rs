@@ -769,7 +769,7 @@ impl Scene {
     /// The base colour at a hit on `triangle` at barycentrics `b`: the one place a hit's colour
     /// is looked up. The material's colour, times the interpolated vertex colour and the
     /// base-colour texture where the scene has them ([`VertexData::base_colour`]).
-    #[inline]
+    #[inline(always)]
     pub fn base_colour(&self, triangle: u32, b: [f32; 3]) -> Vec3 {
         let material = self.triangles[triangle as usize].material;
         let colour = self.materials[material as usize].colour;

@@ -375,16 +375,18 @@ impl Tracer<'_> {
             let sum = each3!(|a| s.load_at(&sum[a], o % 8));
             let colour = match self.settings.mode {
                 Mode::Colour => {
-                    let albedo = |l: usize| {
+                    // Each pixel's base colour, looked up once (one lookup where the block's
+                    // pixels are on one triangle of one colour).
+                    let one = same >> c & 1 == 1 && !varies;
+                    let mut rho = [Vec3::ZERO; 8];
+                    for (l, rho) in rho[..if one { 1 } else { w }].iter_mut().enumerate() {
                         let j = o + l;
-                        let b = [g.b[0][j], g.b[1][j], g.b[2][j]];
-                        self.scene.base_colour(g.tri[j], b)
-                    };
-                    let rho = if same >> c & 1 == 1 && !varies {
-                        let rho = albedo(0);
-                        each3!(|a| s.splat(rho[a]))
-                    } else {
-                        each3!(|a| s.gather(|l| albedo(l)[a]))
+                        *rho =
+                            (self.scene).base_colour(g.tri[j], [g.b[0][j], g.b[1][j], g.b[2][j]]);
+                    }
+                    let rho = match one {
+                        true => each3!(|a| s.splat(rho[0][a])),
+                        false => each3!(|a| s.gather(|l| rho[l][a])),
                     };
                     super::diffuse(s, rho, sum, [s.splat(indirect); 3])
                 }
