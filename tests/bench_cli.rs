@@ -42,8 +42,9 @@ fn text(b: &[u8]) -> String {
 const ROWS_PER_SIZE: usize = 5 + 2 + 4 * 2 + 3 * 2;
 const SIZES: usize = 2;
 
-/// The estimators' rows: 3 scenes × 3 estimators at the quick bench's one count (4 spp).
-const ESTIMATOR_ROWS: usize = 3 * 3;
+/// The estimators' rows: 3 scenes × 3 estimators at the quick bench's one count (4 spp), raw
+/// and denoised.
+const ESTIMATOR_ROWS: usize = 3 * 3 * 2;
 
 /// The throughput section's table: header, alignment, and one row per ray kind (the quick
 /// bench measures the Cornell box only).
@@ -62,7 +63,7 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
         .split_once("The physically based effects")
         .expect("an estimators section");
     // The estimators' table: each physically based scene by each estimator, at the quick
-    // bench's 4 spp, each with an error.
+    // bench's 4 spp, raw and denoised, each with an error.
     let est: Vec<&str> = estimators.lines().filter(|l| l.starts_with('|')).collect();
     assert_eq!(est.len(), 2 + ESTIMATOR_ROWS, "{stdout}");
     for row in &est[2..] {
@@ -70,7 +71,8 @@ fn the_table_has_every_row_and_column_and_the_reference_is_cached() {
         assert!(["area", "plates", "glass"].contains(&cells[0]), "{row}");
         assert!(["light", "bsdf", "mis"].contains(&cells[2]), "{row}");
         assert_eq!(cells[3], "4", "{row}");
-        let rmse: f64 = cells[7].parse().expect("RMSE is a number");
+        assert!(["no", "yes"].contains(&cells[4]), "{row}");
+        let rmse: f64 = cells[8].parse().expect("RMSE is a number");
         assert!(rmse.is_finite() && rmse > 0.0, "{row}");
     }
     let table: Vec<&str> = accuracy.lines().filter(|l| l.starts_with('|')).collect();

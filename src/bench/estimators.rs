@@ -1,8 +1,8 @@
 //! The price of each physically based effect and estimator: the built-in scenes that each call
 //! for one new effect (area lights, glossy metal under lights of several sizes, glass), each
-//! rendered raw with light sampling alone, BSDF sampling alone and MIS at a few samples per
-//! pixel, timed, and compared with a high-sample reference of that scene (cached as the
-//! Cornell box's is).
+//! rendered with light sampling alone, BSDF sampling alone and MIS at a few samples per pixel,
+//! raw and denoised, timed, and compared with a high-sample reference of that scene (cached as
+//! the Cornell box's is).
 
 use std::io;
 
@@ -11,7 +11,7 @@ use super::progress::Progress;
 use super::reference::{self, ReferenceInfo, ReferenceSpec};
 use super::timing::{self, Runs, ms};
 use super::{BenchOptions, MAX_RUNS};
-use crate::render::Options;
+use crate::render::{Options, Output};
 use crate::scene::Scene;
 use crate::scene::builtin;
 use crate::shading::{Estimator, GI_MAX_BOUNCES, RayCounts, Stage};
@@ -41,6 +41,8 @@ pub struct EstimatorRow {
     pub estimator: Estimator,
     /// Samples per pixel.
     pub spp: u32,
+    /// Whether the frame was denoised (its time includes the filter's).
+    pub denoised: bool,
     /// Image width and height in pixels.
     pub width: u32,
     /// See `width`.
@@ -102,14 +104,15 @@ pub fn run(
         max: MAX_RUNS,
     };
     let total: u64 = spps.iter().map(|&s| u64::from(s)).sum::<u64>()
-        * (ESTIMATORS.len() * scenes.len()) as u64
+        * (2 * ESTIMATORS.len() * scenes.len()) as u64
         * u64::from(runs.min + 1);
     progress.start("estimators", total, 0);
     let mut rows = Vec::new();
     for (scene, reference) in scenes.iter().zip(&images) {
         for estimator in ESTIMATORS {
-            for &spp in &spps {
-                progress.message(&format!("{} {} {spp}spp", scene.name(), estimator.name()));
+            for (&spp, denoised) in spps.iter().flat_map(|s| [(s, false), (s, true)]) {
+                let name = format!("{} {} {spp}spp", scene.name(), estimator.name());
+                progress.message(&name);
                 let mut settings = Stage::Gi.settings(scene.effects());
                 settings.effects.samples = spp;
                 settings.estimator = estimator;
@@ -117,6 +120,10 @@ pub fn run(
                     width,
                     height,
                     settings: Some(settings),
+                    output: match denoised {
+                        true => Output::Denoised,
+                        false => Output::Image,
+                    },
                     ..Options::default()
                 };
                 let mut kept = None;
@@ -136,6 +143,7 @@ pub fn run(
                     effects: frame.stats.effect_names(),
                     estimator,
                     spp,
+                    denoised,
                     width,
                     height,
                     median_ms: ms(timing.median()),
@@ -155,9 +163,9 @@ pub fn run(
 mod tests {
     use super::*;
 
-    /// Every scene, estimator and sample count gets a row, each naming what it ran, its error
-    /// finite; the estimators' rays differ as they should (BSDF sampling alone traces no
-    /// area-light shadow ray).
+    /// Every scene, estimator and sample count gets a raw row and a denoised one, each naming
+    /// what it ran, its error finite; the estimators' rays differ as they should (BSDF sampling
+    /// alone traces no area-light shadow ray); the denoised frame is not the raw one.
     #[test]
     fn a_row_per_scene_estimator_and_count() {
         let dir = std::env::temp_dir().join(format!("raytty-estimators-{}", std::process::id()));
@@ -171,17 +179,19 @@ mod tests {
         };
         let (rows, refs) = run(&options, &mut super::super::NoProgress).unwrap();
         assert_eq!(refs.len(), SCENES.len());
-        assert_eq!(rows.len(), SCENES.len() * ESTIMATORS.len());
+        assert_eq!(rows.len(), 2 * SCENES.len() * ESTIMATORS.len());
         for r in &rows {
             assert_eq!((r.spp, r.width, r.height), (4, 12, 8));
             assert!(r.rmse.is_finite() && r.block_rmse.is_finite(), "{r:?}");
             assert!(r.effects.contains(&"path"), "{r:?}");
         }
-        let area = |e: Estimator| {
+        let row = |e: Estimator, denoised: bool| {
             rows.iter()
-                .find(|r| r.scene == "area" && r.estimator == e)
+                .find(|r| r.scene == "area" && r.estimator == e && r.denoised == denoised)
                 .unwrap()
         };
+        let area = |e: Estimator| row(e, false);
+        assert_ne!(row(Estimator::Mis, true).rmse, area(Estimator::Mis).rmse);
         assert!(area(Estimator::Light).rays.shadow > area(Estimator::Bsdf).rays.shadow);
         assert!(
             area(Estimator::Bsdf)

@@ -305,7 +305,7 @@ pub fn body(
 }
 
 /// The price of the physically based effects: a heading line, a table of each scene,
-/// estimator and sample count (raw frames), and how the references were made.
+/// estimator and sample count (raw and denoised), and how the references were made.
 pub fn estimator_markdown(rows: &[EstimatorRow], refs: &[ReferenceInfo]) -> String {
     let mut s = String::new();
     let Some(first) = rows.first() else {
@@ -314,7 +314,7 @@ pub fn estimator_markdown(rows: &[EstimatorRow], refs: &[ReferenceInfo]) -> Stri
     let _ = writeln!(
         s,
         "The physically based effects, each by light sampling alone, BSDF sampling alone and \
-         MIS (the hidden `render --estimator`), raw, at {}x{}, against each scene's reference \
+         MIS (the hidden `render --estimator`), raw and denoised, at {}x{}, against each scene's reference \
          (block RMSE: of 10x10-pixel means; time × RMSE²: lower is more accuracy per second):\n",
         first.width, first.height
     );
@@ -323,6 +323,7 @@ pub fn estimator_markdown(rows: &[EstimatorRow], refs: &[ReferenceInfo]) -> Stri
         ("effects", Align::Left),
         ("estimator", Align::Left),
         ("spp", Align::Right),
+        ("denoised", Align::Left),
         ("median ms (runs)", Align::Right),
         ("shadow", Align::Right),
         ("bounce", Align::Right),
@@ -349,6 +350,7 @@ pub fn estimator_markdown(rows: &[EstimatorRow], refs: &[ReferenceInfo]) -> Stri
             effects.join(", "),
             r.estimator.name().to_string(),
             r.spp.to_string(),
+            (if r.denoised { "yes" } else { "no" }).to_string(),
             format!("{:.1} ({})", r.median_ms, r.runs),
             r.rays.shadow.to_string(),
             r.rays.bounce.to_string(),
