@@ -573,7 +573,9 @@ impl Tracer<'_> {
     }
 
     /// Which of the `traced` points' shadow rays (bit per point) are blocked before `t_max`,
-    /// through the scene's structure.
+    /// through the scene's structure. (Inlined: one ray at a time, [`Tracer::direct_at`] then
+    /// needs no zeroed copy of its point's blocks in memory: a GI frame's instructions −4 %.)
+    #[inline(always)]
     fn blocked<const B: usize>(
         &self,
         pts: &Points<B>,
