@@ -36,7 +36,7 @@ use crate::simd::{Isa, Kernel, Path};
 use node::{Node, NodePair};
 use wide::{LEAF, TreeStats, WIDTH, Wide, leaf_blocks};
 
-pub use build::LEAF_MAX;
+pub use build::{BIG_TREE, LEAF_MAX};
 
 /// Most levels the binary tree has (root = level 1); the builder keeps to it by switching from
 /// SAH to median splits deep down. The wide tree has no more levels than the binary one, so
@@ -68,14 +68,21 @@ pub struct Bvh {
 }
 
 impl Bvh {
-    /// Builds the hierarchy over `triangles` (binned SAH, in parallel; the result does not
-    /// depend on the number of threads).
+    /// Builds the hierarchy over `triangles` (binned SAH, in parallel; from [`BIG_TREE`]
+    /// triangles on, the lower levels as a linear BVH; the result does not depend on the
+    /// number of threads).
     pub fn build(triangles: &[Triangle]) -> Bvh {
+        let morton = (triangles.len() >= BIG_TREE).then_some(build::MORTON_NODE);
+        Bvh::build_with(triangles, morton)
+    }
+
+    /// [`Bvh::build`] with Morton subtrees of at most `morton` triangles, or none.
+    fn build_with(triangles: &[Triangle], morton: Option<usize>) -> Bvh {
         assert!(
             u32::try_from(triangles.len()).is_ok(),
             "a BVH holds at most 2³² − 1 triangles"
         );
-        let built = build::build(triangles);
+        let built = build::build(triangles, morton);
         let tree = TreeStats::of(&built.pairs);
         let c = wide::collapse(&built.pairs, &built.order, triangles);
         Bvh {
@@ -391,6 +398,71 @@ mod tests {
                 build(threads) == one,
                 "{threads} threads built another tree"
             );
+        }
+    }
+
+    /// A big tree's lower levels (Morton subtrees, forced here at a small size under SAH
+    /// levels built in parallel): the same tree on any number of threads, within the depth
+    /// bound, and every closest hit and occlusion the brute-force loop's, on every path.
+    #[test]
+    fn morton_subtrees_are_deterministic_and_exact() {
+        let tris = triangles(displaced_icosphere(71, 0.2));
+        let build = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| Bvh::build_with(&tris, Some(20_000)))
+        };
+        let one = build(1);
+        assert!(one.depth() as usize <= MAX_DEPTH);
+        assert!(one != Bvh::build(&tris), "the Morton levels were not built");
+        for threads in [2, 3] {
+            assert!(
+                build(threads) == one,
+                "{threads} threads built another tree"
+            );
+        }
+        let mut rng = crate::rng::Rng::seeded(7);
+        let mut f = || rng.next_f32() * 2.0 - 1.0;
+        for i in 0..300 {
+            let origin = Vec3::new(f(), f(), f()) * 3.0;
+            // Half the rays aimed at a vertex, where neighbouring triangles tie.
+            let target = if i % 2 == 0 {
+                tris[(f().abs() * tris.len() as f32) as usize % tris.len()].v[i % 3]
+            } else {
+                Vec3::new(f(), f(), f()) * 0.5
+            };
+            let ray = Ray::new(origin, target - origin);
+            let t_max = if i % 3 == 0 {
+                f().abs() * 4.0
+            } else {
+                f32::INFINITY
+            };
+            let mut want: Option<Hit> = None;
+            for (k, t) in tris.iter().enumerate() {
+                if let Some(h) = crate::geometry::intersect_watertight(&ray, &t.v, t_max)
+                    && want.is_none_or(|b| h.t < b.t)
+                {
+                    want = Some(Hit {
+                        t: h.t,
+                        b: h.b,
+                        triangle: k as u32,
+                    });
+                }
+            }
+            for isa in Isa::ALL.into_iter().filter(|i| i.available()) {
+                assert_eq!(
+                    one.intersect_isa(isa, &ray, t_max),
+                    want,
+                    "ray {i} on {isa:?}"
+                );
+                assert_eq!(
+                    one.occluded_isa(isa, &ray, t_max),
+                    want.is_some(),
+                    "ray {i}"
+                );
+            }
         }
     }
 

@@ -300,6 +300,8 @@ impl std::error::Error for SceneError {}
 pub struct SceneBuilder {
     /// Vertex triples with their material, in the order added.
     raw: Vec<([Vec3; 3], u32)>,
+    /// A mesh given by vertex indices, after `raw` (see [`SceneBuilder::indexed_mesh`]).
+    indexed: Option<IndexedMesh>,
     objects: Vec<Range<usize>>,
     materials: Vec<Material>,
     lights: Vec<PointLight>,
@@ -312,6 +314,15 @@ pub struct SceneBuilder {
     step: Option<f32>,
     tone_map: ToneMap,
     vertex: Option<VertexData>,
+}
+
+/// A mesh as model files hold it: shared positions and each triangle's indices into them,
+/// with one material for each triangle (or the last one for the rest).
+#[derive(Clone, Debug, Default)]
+struct IndexedMesh {
+    positions: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
+    materials: Vec<u32>,
 }
 
 /// Stands in for a degenerate triangle while validating; never part of a scene.
@@ -347,6 +358,49 @@ impl SceneBuilder {
         let start = self.raw.len();
         self.raw.extend(triangles);
         self.objects.push(start..self.raw.len());
+    }
+
+    /// Adds a mesh given by `positions` and each triangle's indices into them (every index
+    /// must be in range), with `materials[i]` the material of triangle `i` (the last one for
+    /// triangles past its end; it must not be empty). Unlike [`SceneBuilder::mesh`], the
+    /// vertex triples are never gathered into a list: a 10M-triangle model's load writes 400 MB
+    /// less. Only one such mesh, added last.
+    pub fn indexed_mesh(
+        &mut self,
+        positions: Vec<Vec3>,
+        triangles: Vec<[u32; 3]>,
+        materials: Vec<u32>,
+    ) {
+        assert!(self.indexed.is_none(), "one indexed mesh a scene");
+        assert!(!materials.is_empty(), "an indexed mesh needs a material");
+        let start = self.raw.len();
+        self.objects.push(start..start + triangles.len());
+        self.indexed = Some(IndexedMesh {
+            positions,
+            triangles,
+            materials,
+        });
+    }
+
+    /// The number of triangles added.
+    fn added(&self) -> usize {
+        self.raw.len() + self.indexed.as_ref().map_or(0, |m| m.triangles.len())
+    }
+
+    /// Triangle `i` as added: its vertices and material.
+    #[inline]
+    fn raw(&self, i: usize) -> ([Vec3; 3], u32) {
+        match self.raw.get(i) {
+            Some(&r) => r,
+            None => {
+                let m = self.indexed.as_ref().expect("a triangle index in range");
+                let k = i - self.raw.len();
+                (
+                    m.triangles[k].map(|v| m.positions[v as usize]),
+                    m.materials[k.min(m.materials.len() - 1)],
+                )
+            }
+        }
     }
 
     /// Degenerate triangles are dropped when the scene is built instead of failing it (models
@@ -409,13 +463,22 @@ impl SceneBuilder {
 
     /// Validates and builds the scene. Triangles are checked in parallel; the error names the
     /// first bad one in the order added.
-    pub fn build(self, name: &str, camera: Camera, effects: Effects) -> Result<Scene, SceneError> {
+    pub fn build(
+        mut self,
+        name: &str,
+        camera: Camera,
+        effects: Effects,
+    ) -> Result<Scene, SceneError> {
         // Validated in parallel straight into place (an indexed collect: no intermediate
         // lists); a failure only raises a flag, and then a sequential pass finds the first. A
         // small scene is checked on this thread: the pool is not even started for it.
-        let small = self.raw.len() < PAR_MIN_TRIANGLES;
+        let mut objects = std::mem::take(&mut self.objects);
+        let vertex = self.vertex.take();
+        let added = self.added();
+        let small = added < PAR_MIN_TRIANGLES;
         let failed = AtomicBool::new(false);
-        let validate = |&([a, b, c], m): &([Vec3; 3], u32)| {
+        let validate = |i: usize| {
+            let ([a, b, c], m) = self.raw(i);
             Triangle::new(a, b, c, m).unwrap_or_else(|_| {
                 failed.store(true, Ordering::Relaxed);
                 PLACEHOLDER
@@ -423,50 +486,43 @@ impl SceneBuilder {
         };
         let mut triangles = Vec::new();
         if small {
-            triangles = self.raw.iter().map(validate).collect();
+            triangles = (0..added).map(validate).collect();
         } else {
-            self.raw
-                .par_iter()
+            (0..added)
+                .into_par_iter()
                 .map(validate)
                 .collect_into_vec(&mut triangles);
         }
-        let mut objects = self.objects;
-        let mut vertex = self.vertex.filter(VertexData::calls_for_anything);
+        let mut vertex = vertex.filter(VertexData::calls_for_anything);
         if let Some(v) = &mut vertex {
-            if let Some(problem) = v.problem(self.raw.len(), self.materials.len()) {
+            if let Some(problem) = v.problem(added, self.materials.len()) {
                 return Err(SceneError::VertexData { problem });
             }
             v.sanitise();
         }
         if failed.load(Ordering::Relaxed) && self.drop_degenerate {
-            // Keep the valid triangles in order, each object's range shrunk to its own.
-            let mut kept = Vec::with_capacity(triangles.len());
+            // Keep the valid triangles in order (in place), each object's range shrunk to its
+            // own. A placeholder marks each degenerate one: no valid triangle has its zero area.
+            let valid = |t: &Triangle| t.v != PLACEHOLDER.v;
+            let mut kept = 0;
             let mut ranges = Vec::with_capacity(objects.len());
             for r in &objects {
-                let start = kept.len();
-                for i in r.clone() {
-                    let ([a, b, c], m) = self.raw[i];
-                    if Triangle::new(a, b, c, m).is_ok() {
-                        kept.push(triangles[i]);
-                    }
-                }
-                ranges.push(start..kept.len());
+                let start = kept;
+                kept += triangles[r.clone()].iter().filter(|t| valid(t)).count();
+                ranges.push(start..kept);
             }
             ranges.retain(|r| !r.is_empty());
             if let Some(v) = &mut vertex {
-                v.retain_triangles(|i| {
-                    let ([a, b, c], m) = self.raw[i];
-                    Triangle::new(a, b, c, m).is_ok()
-                });
+                v.retain_triangles(|i| valid(&triangles[i]));
             }
-            triangles = kept;
+            triangles.retain(valid);
             objects = ranges;
         } else if failed.into_inner() {
-            let (index, problem) = self
-                .raw
-                .iter()
-                .enumerate()
-                .find_map(|(i, &([a, b, c], m))| Triangle::new(a, b, c, m).err().map(|e| (i, e)))
+            let (index, problem) = (0..added)
+                .find_map(|i| {
+                    let ([a, b, c], m) = self.raw(i);
+                    Triangle::new(a, b, c, m).err().map(|e| (i, e))
+                })
                 .expect("a triangle failed to validate");
             return Err(SceneError::Triangle { index, problem });
         }
@@ -539,6 +595,7 @@ impl SceneBuilder {
             .accel
             .unwrap_or_else(|| AccelKind::for_triangles(triangles.len()));
         drop(self.raw);
+        drop(self.indexed);
         let accel = Accel::build_kind(&triangles, &objects, kind);
         let has_mirrors = self.materials.iter().any(|m| m.mirror > 0.0);
         // Only a scene with an emitting material looks for emitting triangles.

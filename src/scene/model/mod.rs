@@ -248,13 +248,6 @@ impl Model {
         let mut b = SceneBuilder::new();
         b.drop_degenerate();
         let (materials, material_textures) = self.scene_materials(&mut b);
-        let positions = &self.positions;
-        b.mesh(self.triangles.iter().enumerate().map(|(i, t)| {
-            (
-                t.map(|v| positions[v as usize]),
-                materials[i.min(materials.len() - 1)],
-            )
-        }));
         // A point light of radiant intensity I emits 4π·I; a spot is the point light it is
         // cut from.
         let mut lights: Vec<PointLight> = Vec::new();
@@ -322,8 +315,7 @@ impl Model {
             b.vertex_data(v);
         }
         let mut notes = self.notes;
-        drop(self.positions);
-        drop(self.triangles);
+        b.indexed_mesh(self.positions, self.triangles, materials);
         let scene = b
             .build(name, camera, effects)
             .map_err(|e| SceneFileError::whole_file(file, e.to_string()))?;
@@ -375,14 +367,16 @@ impl Model {
 
     /// What the vertices carry that changes a frame, for the scene (`None` if nothing):
     /// colours, normals, and texture coordinates when a material has a texture.
-    /// `material_textures` is each scene material's texture. Takes the lists it keeps.
+    /// `material_textures` is each scene material's texture. Takes the lists it keeps (all but
+    /// the triangles).
     fn vertex_data(&mut self, material_textures: Vec<Option<u32>>) -> Option<VertexData> {
         let textured = material_textures.iter().any(Option::is_some);
         if self.colours.is_empty() && self.normals.is_empty() && !textured {
             return None;
         }
         Some(VertexData {
-            corners: std::mem::take(&mut self.triangles),
+            // (The scene's mesh keeps the triangles too.)
+            corners: self.triangles.clone(),
             normals: std::mem::take(&mut self.normals),
             uvs: if textured {
                 std::mem::take(&mut self.uvs)
