@@ -1,6 +1,9 @@
 //! Walker's alias method (Vose's construction): one of n items in proportion to its weight,
 //! in constant time per draw.
 
+/// The largest `f32` below 1.
+const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
+
 /// A table that picks item i with probability `weights[i] / Σ weights`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AliasTable {
@@ -71,16 +74,26 @@ impl AliasTable {
     /// An item from one uniform number `u` in `[0, 1)`, and its probability: `u·n` picks a
     /// column, its fraction decides between the column's item and its alias.
     pub fn sample(&self, u: f32) -> (usize, f32) {
+        let (i, p, _) = self.sample_remapped(u);
+        (i, p)
+    }
+
+    /// [`AliasTable::sample`], and `u` made uniform again for another use: where in its part
+    /// of the column `u` fell, rescaled to `[0, 1)` (uniform given the item, as each column's
+    /// part is; pbrt-v4's alias table does the same). So one number picks the item and
+    /// places a point on it.
+    pub fn sample_remapped(&self, u: f32) -> (usize, f32, f32) {
         let n = self.len();
         let x = u.clamp(0.0, 1.0) * n as f32;
         let column = (x as usize).min(n - 1);
         let up = (x - column as f32).min(1.0);
-        let i = if up < self.keep[column] {
-            column
+        let keep = self.keep[column];
+        let (i, rest) = if up < keep {
+            (column, up / keep)
         } else {
-            self.alias[column] as usize
+            (self.alias[column] as usize, (up - keep) / (1.0 - keep))
         };
-        (i, self.pmf[i])
+        (i, self.pmf[i], rest.min(ONE_BELOW))
     }
 }
 
@@ -113,6 +126,34 @@ mod tests {
         }
         // 5 degrees of freedom: P(χ² > 20.5) = 0.001.
         assert!(chi2 < 20.5, "χ² = {chi2}, counts {counts:?}");
+    }
+
+    #[test]
+    fn the_remapped_number_is_uniform_given_the_item() {
+        // Per item, the remapped numbers fall evenly into 8 bins (χ² over seeded draws), and
+        // the item is the one `sample` picks.
+        let weights = [14.0, 2.0, 0.0, 2.0, 0.5, 30.0, 1.0];
+        let t = AliasTable::new(&weights).unwrap();
+        let mut rng = Rng::seeded(8);
+        let mut bins = [[0u32; 8]; 7];
+        for _ in 0..400_000 {
+            let u = rng.next_f32();
+            let (i, p, rest) = t.sample_remapped(u);
+            assert_eq!((i, p), t.sample(u));
+            assert!((0.0..1.0).contains(&rest), "{rest}");
+            bins[i][(rest * 8.0) as usize] += 1;
+        }
+        for (i, b) in bins.iter().enumerate() {
+            let n: u32 = b.iter().sum();
+            if weights[i] == 0.0 {
+                assert_eq!(n, 0);
+                continue;
+            }
+            let e = f64::from(n) / 8.0;
+            let chi2: f64 = b.iter().map(|&c| (f64::from(c) - e).powi(2) / e).sum();
+            // 7 degrees of freedom: P(χ² > 24.3) = 0.001.
+            assert!(chi2 < 24.3, "item {i}: χ² = {chi2}, {b:?}");
+        }
     }
 
     #[test]

@@ -18,19 +18,32 @@ pub struct TrianglePoint {
 /// `b1 = u₁√u₀` (the square root spreads the points evenly between the apex `v[0]` and the
 /// opposite edge). `None` for a triangle of zero area.
 pub fn sample_triangle(v: &[Vec3; 3], u: Vec2) -> Option<TrianglePoint> {
-    let area = 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length();
+    let area = triangle_area(v);
     if !(area > 0.0) || !area.is_finite() {
         return None;
     }
+    let b = triangle_barycentrics(u);
+    Some(TrianglePoint {
+        position: v[0] * b.x + v[1] * b.y + v[2] * b.z,
+        barycentric: b,
+        pdf_area: 1.0 / area,
+    })
+}
+
+/// The area of the triangle `v`.
+#[inline]
+pub(super) fn triangle_area(v: &[Vec3; 3]) -> f32 {
+    0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length()
+}
+
+/// [`sample_triangle`]'s barycentric coordinates from its two uniform numbers.
+#[inline]
+pub(super) fn triangle_barycentrics(u: Vec2) -> Vec3 {
     let s = u.x.clamp(0.0, 1.0).sqrt();
     let b0 = 1.0 - s;
     let b1 = u.y.clamp(0.0, 1.0) * s;
     let b2 = (1.0 - b0 - b1).max(0.0);
-    Some(TrianglePoint {
-        position: v[0] * b0 + v[1] * b1 + v[2] * b2,
-        barycentric: Vec3::new(b0, b1, b2),
-        pdf_area: 1.0 / area,
-    })
+    Vec3::new(b0, b1, b2)
 }
 
 /// A density per area at a point on a light turned into one per solid angle at `reference`:

@@ -3,7 +3,8 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{AliasTable, sample_triangle};
+use super::AliasTable;
+use super::area::{triangle_area, triangle_barycentrics};
 use crate::geometry::Triangle;
 
 /// A scene's emitting triangles, each with its emission, and the table that picks them.
@@ -11,8 +12,25 @@ use crate::geometry::Triangle;
 pub struct AreaLights {
     /// The emitting triangles' indices in the scene, ascending.
     triangles: Vec<u32>,
+    /// What drawing a point on each of `triangles` needs, in the same order: kept apart from
+    /// the scene's triangles so that a draw reads one record and computes no area (next-event
+    /// estimation draws one per path vertex).
+    emitters: Vec<Emitter>,
     /// Picks a position in `triangles` by power (emission summed over the channels × area).
     table: AliasTable,
+}
+
+/// An emitting triangle as [`AreaLights::sample`] reads it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Emitter {
+    /// The triangle's vertices.
+    v: [Vec3; 3],
+    /// Its front normal ([`Triangle::front`]).
+    front: Vec3,
+    /// What its front face emits.
+    emission: Vec3,
+    /// The density per unit area of drawing a point on it: its probability over its area.
+    pdf_area: f32,
 }
 
 /// A point drawn on one of the lights.
@@ -24,6 +42,10 @@ pub struct LightPoint {
     pub position: Vec3,
     /// The density per unit area of drawing it: the triangle's probability over its area.
     pub pdf_area: f32,
+    /// The triangle's front normal: only that side emits.
+    pub front: Vec3,
+    /// What the front face emits.
+    pub emission: Vec3,
 }
 
 impl AreaLights {
@@ -32,17 +54,30 @@ impl AreaLights {
     pub fn new(triangles: &[Triangle], emission: impl Fn(&Triangle) -> Vec3) -> Option<AreaLights> {
         let mut ids = Vec::new();
         let mut power = Vec::new();
+        let mut emitters = Vec::new();
         for (i, t) in triangles.iter().enumerate() {
             let e = emission(t);
             if e.max_element() > 0.0 {
-                let area = 0.5 * (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).length();
+                let area = triangle_area(&t.v);
                 ids.push(i as u32);
                 power.push((e.x + e.y + e.z) * area);
+                emitters.push(Emitter {
+                    v: t.v,
+                    front: t.front(),
+                    emission: e,
+                    pdf_area: 0.0,
+                });
             }
         }
         let table = AliasTable::new(&power)?;
+        for (k, em) in emitters.iter_mut().enumerate() {
+            // A triangle of zero area has zero power: never picked, and no density.
+            let area = triangle_area(&em.v);
+            em.pdf_area = if area > 0.0 { table.pmf(k) / area } else { 0.0 };
+        }
         Some(AreaLights {
             triangles: ids,
+            emitters,
             table,
         })
     }
@@ -57,27 +92,33 @@ impl AreaLights {
         self.triangles.is_empty()
     }
 
-    /// A light picked by `u` (in proportion to power), and a point on it by area from `uv`.
-    pub fn sample(&self, triangles: &[Triangle], u: f32, uv: Vec2) -> Option<LightPoint> {
-        let (k, pmf) = self.table.sample(u);
-        let triangle = self.triangles[k];
-        let p = sample_triangle(&triangles[triangle as usize].v, uv)?;
+    /// A light picked by `u.x` (in proportion to power), and a point on it by area (as
+    /// [`super::sample_triangle`] draws it) from `u.x` made uniform again
+    /// ([`AliasTable::sample_remapped`]) and `u.y`: one 2D point spread evenly over the lights
+    /// is spread evenly over each.
+    pub fn sample(&self, u: Vec2) -> Option<LightPoint> {
+        let (k, _, x) = self.table.sample_remapped(u.x);
+        let em = &self.emitters[k];
+        if !(em.pdf_area > 0.0) || !em.pdf_area.is_finite() {
+            return None;
+        }
+        let b = triangle_barycentrics(Vec2::new(x, u.y));
         Some(LightPoint {
-            triangle,
-            position: p.position,
-            pdf_area: pmf * p.pdf_area,
+            triangle: self.triangles[k],
+            position: em.v[0] * b.x + em.v[1] * b.y + em.v[2] * b.z,
+            pdf_area: em.pdf_area,
+            front: em.front,
+            emission: em.emission,
         })
     }
 
     /// The density per unit area with which [`AreaLights::sample`] draws a point on
     /// `triangle` (0 for a triangle that does not emit).
-    pub fn pdf_area(&self, triangles: &[Triangle], triangle: u32) -> f32 {
-        let Ok(k) = self.triangles.binary_search(&triangle) else {
-            return 0.0;
-        };
-        let v = &triangles[triangle as usize].v;
-        let area = 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length();
-        self.table.pmf(k) / area
+    pub fn pdf_area(&self, triangle: u32) -> f32 {
+        match self.triangles.binary_search(&triangle) {
+            Ok(k) => self.emitters[k].pdf_area,
+            Err(_) => 0.0,
+        }
     }
 }
 
@@ -98,21 +139,19 @@ mod tests {
             |t: &Triangle| [Vec3::ZERO, Vec3::splat(4.0), Vec3::splat(1.0)][t.material as usize];
         let lights = AreaLights::new(&tris, emission).unwrap();
         assert_eq!(lights.len(), 2);
-        assert_eq!(lights.pdf_area(&tris, 0), 0.0);
+        assert_eq!(lights.pdf_area(0), 0.0);
         // Equal power: each is picked half the time, and its density is that over its area.
-        assert!((lights.pdf_area(&tris, 1) - 0.5 / 0.5).abs() < 1e-6);
-        assert!((lights.pdf_area(&tris, 2) - 0.5 / 2.0).abs() < 1e-6);
+        assert!((lights.pdf_area(1) - 0.5 / 0.5).abs() < 1e-6);
+        assert!((lights.pdf_area(2) - 0.5 / 2.0).abs() < 1e-6);
         let mut rng = Rng::seeded(1);
         let mut on = [0u32; 3];
         for _ in 0..10_000 {
             let p = lights
-                .sample(
-                    &tris,
-                    rng.next_f32(),
-                    Vec2::new(rng.next_f32(), rng.next_f32()),
-                )
+                .sample(Vec2::new(rng.next_f32(), rng.next_f32()))
                 .unwrap();
-            assert_eq!(p.pdf_area, lights.pdf_area(&tris, p.triangle));
+            assert_eq!(p.pdf_area, lights.pdf_area(p.triangle));
+            let t = &tris[p.triangle as usize];
+            assert_eq!((p.front, p.emission), (t.front(), emission(t)));
             on[p.triangle as usize] += 1;
         }
         assert_eq!(on[0], 0);

@@ -80,6 +80,17 @@ impl SurfaceBsdf {
             .fold(BsdfFlags::NONE, |f, (_, b)| f | b.flags())
     }
 
+    /// Which of [`SurfaceBsdf::sample_f`]'s numbers it reads: `uc` (where it picks a lobe or
+    /// chooses between reflection and refraction) and `u` (where a lobe is not specular).
+    /// A path draws only those.
+    pub fn draws(&self) -> (bool, bool) {
+        let flags = self.flags();
+        (
+            self.count > 1 || flags.contains(BsdfFlags::TRANSMISSION),
+            flags.intersects(BsdfFlags::DIFFUSE | BsdfFlags::GLOSSY),
+        )
+    }
+
     /// `Σ wᵢ fᵢ(wo, wi)`, transmitted light tinted.
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let f: Vec3 = self.lobes().iter().map(|(w, b)| b.f(wo, wi) * *w).sum();

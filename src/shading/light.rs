@@ -11,8 +11,8 @@ use glam::{Vec2, Vec3};
 use super::lane::{Lanes, Scalar, each3};
 use super::surface::{Surface, dot, offset_origin};
 use crate::geometry::Ray;
-use crate::light::{AreaLights, area_to_solid_angle};
-use crate::scene::{DirectionalLight, PointLight, Scene, SpotLight};
+use crate::light::AreaLights;
+use crate::scene::{DirectionalLight, PointLight, SpotLight};
 
 /// The kinds of light a frame ran besides point lights and emitting triangles (for `render
 /// --stats`): each only where the scene has one that gives light and the frame shades.
@@ -54,32 +54,31 @@ pub(crate) struct AreaIncident {
     pub shadow: Ray,
 }
 
-/// One of `lights` picked by power with `u`, a point on it by area with `uv`, seen from the
-/// point `at`: `None` where the light's back faces the point or is edge-on (it sends nothing
+/// One of `lights` picked by power and a point on it by area, both from `u`
+/// ([`AreaLights::sample`]), seen from the point `at`: `None` where the light's back faces the point or is edge-on (it sends nothing
 /// there, and no shadow ray is traced).
-pub(crate) fn area_light(
-    scene: &Scene,
-    lights: &AreaLights,
-    at: &Surface<f32>,
-    u: f32,
-    uv: Vec2,
-) -> Option<AreaIncident> {
-    let tris = scene.triangles();
-    let lp = lights.sample(tris, u, uv)?;
-    let tri = &tris[lp.triangle as usize];
+pub(crate) fn area_light(lights: &AreaLights, at: &Surface<f32>, u: Vec2) -> Option<AreaIncident> {
+    let lp = lights.sample(u)?;
     let p = Vec3::from_array(at.p);
     let d = lp.position - p;
-    // Only the light's front face emits.
-    if !(d.dot(tri.front()) < 0.0) {
+    // Only the light's front face emits; edge-on or on the point, it sends nothing.
+    let cos_d = -d.dot(lp.front);
+    if !(cos_d > 0.0) {
         return None;
     }
-    let pdf = area_to_solid_angle(lp.pdf_area, p, lp.position, tri.front())?;
-    let wi = d.normalize();
+    // `area_to_solid_angle`'s `pdf_area·r²/cos θ`, with cos θ = cos_d/r.
+    let r2 = d.length_squared();
+    let r = r2.sqrt();
+    let pdf = lp.pdf_area * r2 * r / cos_d;
+    if !(pdf.is_finite() && pdf > 0.0) {
+        return None;
+    }
+    let wi = d / r;
     let origin = Vec3::from_array(offset_origin(Scalar, at, wi.to_array()));
     Some(AreaIncident {
         wi,
         pdf,
-        emission: scene.materials()[tri.material as usize].emission,
+        emission: lp.emission,
         shadow: Ray::new(origin, lp.position - origin),
     })
 }

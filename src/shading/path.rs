@@ -266,7 +266,7 @@ impl Tracer<'_> {
                     (Some(pb), _) => {
                         let area = scene
                             .area_lights()
-                            .map_or(0.0, |a| a.pdf_area(tris, hit.triangle));
+                            .map_or(0.0, |a| a.pdf_area(hit.triangle));
                         let pl =
                             area_to_solid_angle(area, came.from, p, tri.front()).unwrap_or(0.0);
                         power_heuristic(pb, pl)
@@ -282,11 +282,15 @@ impl Tracer<'_> {
             let toward = -ray.dir.normalize();
             let (frame, wo) = self.frame(&at, front, toward);
             let bsdf = SurfaceBsdf::new(material, scene.base_colour(hit.triangle, hit.b));
-            let smooth_only = !bsdf
-                .flags()
-                .intersects(BsdfFlags::DIFFUSE | BsdfFlags::GLOSSY);
-            let u_light = (rng.next_1d(), rng.next_2d());
-            let u_bsdf = (rng.next_1d(), rng.next_2d());
+            // Only the numbers this vertex uses are drawn: each costs a Sobol dimension (a
+            // hash per coordinate), and a diffuse or metal vertex has no lobe to choose.
+            let (draws_choice, draws_direction) = bsdf.draws();
+            let smooth_only = !draws_direction;
+            let u_bsdf = if draws_direction {
+                Vec2::from(rng.next_2d())
+            } else {
+                Vec2::ZERO
+            };
             if !smooth_only {
                 // Point, directional and spot lights: exact, as the seed's (π·f times the
                 // light's irradiance term), one shadow ray each.
@@ -339,7 +343,7 @@ impl Tracer<'_> {
                         pdf,
                         emission,
                         shadow,
-                    }) = area_light(scene, lights, &at, u_light.0, Vec2::from(u_light.1))
+                    }) = area_light(lights, &at, Vec2::from(rng.next_2d()))
                 {
                     let wl = frame.to_local(wi);
                     let f = self.f_both_sides(&bsdf, wo, wl, wi, front);
@@ -357,7 +361,8 @@ impl Tracer<'_> {
                 }
             }
             // Go on along a direction the BSDF picks.
-            let Some(s) = bsdf.sample_f(wo, u_bsdf.0, Vec2::from(u_bsdf.1)) else {
+            let u_choice = if draws_choice { rng.next_1d() } else { 0.5 };
+            let Some(s) = bsdf.sample_f(wo, u_choice, u_bsdf) else {
                 break;
             };
             let mut weight = s.weight();
