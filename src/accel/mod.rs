@@ -116,6 +116,39 @@ enum Structure {
     Bvh(Bvh),
 }
 
+/// Where a structure reads the triangles' vertices: a scene's list of [`Triangle`]s, or a big
+/// model's indexed mesh, which keeps no such list.
+pub trait Vertices: Sync {
+    /// The number of triangles.
+    fn count(&self) -> usize;
+    /// Triangle `i`'s vertices.
+    fn vertices(&self, i: usize) -> [glam::Vec3; 3];
+}
+
+impl Vertices for [Triangle] {
+    #[inline]
+    fn count(&self) -> usize {
+        self.len()
+    }
+
+    #[inline]
+    fn vertices(&self, i: usize) -> [glam::Vec3; 3] {
+        self[i].v
+    }
+}
+
+impl Vertices for Vec<Triangle> {
+    #[inline]
+    fn count(&self) -> usize {
+        self.len()
+    }
+
+    #[inline]
+    fn vertices(&self, i: usize) -> [glam::Vec3; 3] {
+        self[i].v
+    }
+}
+
 impl Default for Accel {
     fn default() -> Accel {
         Accel::build_kind(&[], &[], AccelKind::Flat)
@@ -161,6 +194,24 @@ impl Accel {
     /// The SIMD path its queries take (by default the widest the CPU has).
     pub fn isa(&self) -> Isa {
         self.isa
+    }
+
+    /// A BVH over the triangles of a big model's `source`, built fast ([`Bvh::build_fast`]).
+    pub(crate) fn build_fast(source: &(impl Vertices + ?Sized)) -> Accel {
+        let start = Instant::now();
+        let bvh = Bvh::build_fast(source);
+        let build = start.elapsed();
+        Accel {
+            stats: AccelStats {
+                kind: AccelKind::Bvh,
+                triangles: source.count(),
+                nodes: bvh.nodes(),
+                depth: bvh.depth(),
+                build,
+            },
+            structure: Structure::Bvh(bvh),
+            isa: Isa::detect(),
+        }
     }
 
     /// The same structure, queried on path `isa`; `None` if this CPU does not have it. Every

@@ -76,7 +76,7 @@ fn batches(scene: &Scene, width: u32, height: u32) -> Vec<Batch> {
             let Some(hit) = scene.intersect(&ray, f32::INFINITY) else {
                 continue;
             };
-            let tri = &scene.triangles()[hit.triangle as usize];
+            let tri = &scene.triangle(hit.triangle);
             let (p, err) = hit_point(&tri.v, hit.b);
             let n = if tri.normal.dot(ray.dir) > 0.0 {
                 -tri.normal
@@ -186,7 +186,7 @@ pub fn measure(scene: &Scene, width: u32, height: u32, runs: u32) -> Throughput 
         .collect();
     Throughput {
         scene: scene.name().to_string(),
-        triangles: scene.triangles().len(),
+        triangles: scene.triangle_count(),
         accel: scene.accel_stats().kind.name(),
         width,
         height,

@@ -228,6 +228,9 @@ pub struct Scene {
     /// The vertices' normals, texture coordinates, colours and textures; `None` for a scene
     /// that has none of them, which shades exactly as the seed's scenes do.
     vertex: Option<Box<VertexData>>,
+    /// A big model's triangles, kept as its indexed mesh instead of in `triangles` (which is
+    /// then empty): see [`Scene::triangle`].
+    mesh: Option<Box<IndexedMesh>>,
 }
 
 /// Why a scene could not be built.
@@ -302,6 +305,9 @@ pub struct SceneBuilder {
     raw: Vec<([Vec3; 3], u32)>,
     /// A mesh given by vertex indices, after `raw` (see [`SceneBuilder::indexed_mesh`]).
     indexed: Option<IndexedMesh>,
+    /// Tests: the size from which an indexed mesh is kept ([`MESH_SCENE`]).
+    #[cfg(test)]
+    mesh_from: Option<usize>,
     objects: Vec<Range<usize>>,
     materials: Vec<Material>,
     lights: Vec<PointLight>,
@@ -323,6 +329,57 @@ struct IndexedMesh {
     positions: Vec<Vec3>,
     triangles: Vec<[u32; 3]>,
     materials: Vec<u32>,
+}
+
+/// A model of at least this many triangles (and nothing emitting: area lights read a list)
+/// keeps its indexed mesh, about 18 bytes a triangle plus 4 for several materials, instead of
+/// a list of [`Triangle`]s of 52 (with its BVH, about 48 bytes a triangle that holds the
+/// vertices again for traversal, a 10M-triangle PLY then takes under 100 bytes a triangle),
+/// and its BVH is built fast (`Bvh::build_fast`): a million-triangle model
+/// shows its first frame sooner. Built-in scenes and scene files keep a list and the SAH tree.
+pub const MESH_SCENE: usize = 1 << 19;
+
+impl IndexedMesh {
+    #[inline]
+    fn material(&self, i: usize) -> u32 {
+        self.materials[i.min(self.materials.len() - 1)]
+    }
+
+    /// Triangle `i`, as [`Triangle::new`] makes it (the scene checked that it can).
+    fn triangle(&self, i: usize) -> Triangle {
+        let [a, b, c] = crate::accel::Vertices::vertices(self, i);
+        let t = Triangle::new(a, b, c, self.material(i));
+        debug_assert!(t.is_ok(), "a mesh scene holds only valid triangles");
+        t.unwrap_or(PLACEHOLDER)
+    }
+
+    /// Keeps the triangles for which `keep` holds (their materials with them).
+    fn retain(&mut self, keep: &[bool]) {
+        let mut i = 0;
+        self.triangles.retain(|_| {
+            i += 1;
+            keep[i - 1]
+        });
+        if self.materials.len() == keep.len() {
+            let mut i = 0;
+            self.materials.retain(|_| {
+                i += 1;
+                keep[i - 1]
+            });
+        }
+    }
+}
+
+impl crate::accel::Vertices for IndexedMesh {
+    #[inline]
+    fn count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    #[inline]
+    fn vertices(&self, i: usize) -> [Vec3; 3] {
+        self.triangles[i].map(|v| self.positions[v as usize])
+    }
 }
 
 /// Stands in for a degenerate triangle while validating; never part of a scene.
@@ -476,6 +533,18 @@ impl SceneBuilder {
         let vertex = self.vertex.take();
         let added = self.added();
         let small = added < PAR_MIN_TRIANGLES;
+        #[cfg(test)]
+        let mesh_from = self.mesh_from.unwrap_or(MESH_SCENE);
+        #[cfg(not(test))]
+        let mesh_from = MESH_SCENE;
+        let keep_mesh = self.raw.is_empty()
+            && self.indexed.is_some()
+            && added >= mesh_from
+            && !self.materials.iter().any(Material::emits);
+        let valid_raw = |i: usize| {
+            let ([a, b, c], m) = self.raw(i);
+            Triangle::new(a, b, c, m).is_ok()
+        };
         let failed = AtomicBool::new(false);
         let validate = |i: usize| {
             let ([a, b, c], m) = self.raw(i);
@@ -485,7 +554,12 @@ impl SceneBuilder {
             })
         };
         let mut triangles = Vec::new();
-        if small {
+        if keep_mesh {
+            // No list: each triangle is rebuilt from the mesh where it is read.
+            if !(0..added).into_par_iter().all(valid_raw) {
+                failed.store(true, Ordering::Relaxed);
+            }
+        } else if small {
             triangles = (0..added).map(validate).collect();
         } else {
             (0..added)
@@ -500,7 +574,28 @@ impl SceneBuilder {
             }
             v.sanitise();
         }
-        if failed.load(Ordering::Relaxed) && self.drop_degenerate {
+        if failed.load(Ordering::Relaxed) && self.drop_degenerate && keep_mesh {
+            let mut keep = Vec::new();
+            (0..added)
+                .into_par_iter()
+                .map(valid_raw)
+                .collect_into_vec(&mut keep);
+            let mut kept = 0;
+            let mut ranges = Vec::with_capacity(objects.len());
+            for r in &objects {
+                let start = kept;
+                kept += keep[r.clone()].iter().filter(|&&k| k).count();
+                ranges.push(start..kept);
+            }
+            ranges.retain(|r| !r.is_empty());
+            if let Some(v) = &mut vertex {
+                v.retain_triangles(|i| keep[i]);
+            }
+            if let Some(m) = &mut self.indexed {
+                m.retain(&keep);
+            }
+            objects = ranges;
+        } else if failed.load(Ordering::Relaxed) && self.drop_degenerate {
             // Keep the valid triangles in order (in place), each object's range shrunk to its
             // own. A placeholder marks each degenerate one: no valid triangle has its zero area.
             let valid = |t: &Triangle| t.v != PLACEHOLDER.v;
@@ -528,7 +623,9 @@ impl SceneBuilder {
         }
         let materials = self.materials.len();
         let bad_material = |t: &Triangle| t.material as usize >= materials;
-        let first_bad = if small {
+        let first_bad = if let (true, Some(m)) = (keep_mesh, &self.indexed) {
+            m.materials.iter().position(|&k| k as usize >= materials)
+        } else if small {
             triangles.iter().position(bad_material)
         } else {
             triangles.par_iter().position_first(bad_material)
@@ -575,7 +672,22 @@ impl SceneBuilder {
             return Err(SceneError::LightOfKind { kind, index: 0 });
         }
         // The union of boxes is exact (min and max), so any order gives the same bounds.
-        let bounds = if small {
+        let count = match (keep_mesh, &self.indexed) {
+            (true, Some(m)) => m.triangles.len(),
+            _ => triangles.len(),
+        };
+        let bounds = if let (true, Some(m)) = (keep_mesh, &self.indexed) {
+            (0..count)
+                .into_par_iter()
+                .map(|i| {
+                    let v = crate::accel::Vertices::vertices(m, i);
+                    Aabb {
+                        min: v[0].min(v[1]).min(v[2]),
+                        max: v[0].max(v[1]).max(v[2]),
+                    }
+                })
+                .reduce(|| Aabb::EMPTY, Aabb::union)
+        } else if small {
             triangles
                 .iter()
                 .map(Aabb::of_triangle)
@@ -586,17 +698,21 @@ impl SceneBuilder {
                 .map(Aabb::of_triangle)
                 .reduce(|| Aabb::EMPTY, Aabb::union)
         };
-        let extent = if triangles.is_empty() {
+        let extent = if count == 0 {
             1.0
         } else {
             (bounds.max - bounds.min).length()
         };
         let kind = self
             .accel
-            .unwrap_or_else(|| AccelKind::for_triangles(triangles.len()));
+            .unwrap_or_else(|| AccelKind::for_triangles(count));
         drop(self.raw);
-        drop(self.indexed);
-        let accel = Accel::build_kind(&triangles, &objects, kind);
+        let mesh = self.indexed.take().filter(|_| keep_mesh).map(Box::new);
+        // (A kept mesh is big: a BVH whatever the kind asked for.)
+        let accel = match &mesh {
+            Some(m) => Accel::build_fast(&**m),
+            None => Accel::build_kind(&triangles, &objects, kind),
+        };
         let has_mirrors = self.materials.iter().any(|m| m.mirror > 0.0);
         // Only a scene with an emitting material looks for emitting triangles.
         let area_lights = if self.materials.iter().any(Material::emits) {
@@ -636,6 +752,7 @@ impl SceneBuilder {
                 Vec3::ZERO
             },
             vertex: vertex.map(Box::new),
+            mesh,
         })
     }
 }
@@ -653,9 +770,46 @@ impl Scene {
         self
     }
 
-    /// All triangles, each finite with a unit normal; [`Hit::triangle`] indexes this.
+    /// All triangles as a list, each finite with a unit normal; [`Hit::triangle`] indexes
+    /// this. Empty for the scene of a big model (at least [`MESH_SCENE`] triangles, nothing
+    /// emitting), which keeps its indexed mesh instead: [`Scene::triangle`] and
+    /// [`Scene::triangle_count`] read any scene's.
     pub fn triangles(&self) -> &[Triangle] {
         &self.triangles
+    }
+
+    /// Triangle `triangle` (as [`Hit::triangle`] names it).
+    #[inline]
+    pub fn triangle(&self, triangle: u32) -> Triangle {
+        // The bounds check of the list's index is the only test a scene with a list pays.
+        match self.triangles.get(triangle as usize) {
+            Some(t) => *t,
+            None => self.mesh_triangle(triangle),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn mesh_triangle(&self, triangle: u32) -> Triangle {
+        let mesh = self.mesh.as_deref().expect("a triangle index in range");
+        mesh.triangle(triangle as usize)
+    }
+
+    /// The material of triangle `triangle`.
+    #[inline]
+    pub fn material_of(&self, triangle: u32) -> u32 {
+        match self.triangles.get(triangle as usize) {
+            Some(t) => t.material,
+            None => {
+                let mesh = self.mesh.as_deref().expect("a triangle index in range");
+                mesh.material(triangle as usize)
+            }
+        }
+    }
+
+    /// The number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len() + self.mesh.as_ref().map_or(0, |m| m.triangles.len())
     }
 
     /// Materials; [`Triangle::material`] indexes this.
@@ -789,7 +943,8 @@ impl Scene {
     /// every kind finds the same hits (see [`crate::accel`]).
     pub fn with_accel(mut self, kind: AccelKind) -> Scene {
         let isa = self.accel.isa();
-        self.accel = Accel::build_kind(&self.triangles, &self.objects, kind)
+        self.accel = self
+            .build_accel(kind)
             .with_isa(isa)
             .expect("the scene's path is available");
         self
@@ -810,7 +965,14 @@ impl Scene {
     /// A new acceleration structure of `kind` over this scene's triangles (for timing builds;
     /// [`Scene::with_accel`] installs one).
     pub fn build_accel(&self, kind: AccelKind) -> Accel {
-        Accel::build_kind(&self.triangles, &self.objects, kind)
+        match (&self.mesh, kind) {
+            (Some(m), AccelKind::Bvh) => Accel::build_fast(&**m),
+            (Some(m), AccelKind::Flat) => {
+                let list: Vec<Triangle> = (0..m.triangles.len()).map(|i| m.triangle(i)).collect();
+                Accel::build_kind(&list, &self.objects, kind)
+            }
+            (None, _) => Accel::build_kind(&self.triangles, &self.objects, kind),
+        }
     }
 
     /// The acceleration structure's kind, size and build time.
@@ -828,7 +990,7 @@ impl Scene {
     /// base-colour texture where the scene has them ([`VertexData::base_colour`]).
     #[inline(always)]
     pub fn base_colour(&self, triangle: u32, b: [f32; 3]) -> Vec3 {
-        let material = self.triangles[triangle as usize].material;
+        let material = self.material_of(triangle);
         let colour = self.materials[material as usize].colour;
         match &self.vertex {
             None => colour,
@@ -890,3 +1052,59 @@ const PAR_MIN_TRIANGLES: usize = 4096;
 /// diagonal: 1e-3 of a 3.5-unit Cornell box is 3.5 mm of a 55 cm room, small enough to change
 /// no pixel of the seed's views, large enough that `1/r²` stays far from overflow.
 pub const MIN_LIGHT_DISTANCE_FRACTION: f32 = 1e-3;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A model's mesh kept as it is (a big model's storage, forced here at a small size) reads
+    /// as the list it replaces: the same triangles (degenerate ones dropped), materials,
+    /// bounds and frames, bit for bit.
+    #[test]
+    fn a_kept_mesh_reads_as_the_list() {
+        let mut soup = procedural::displaced_icosphere(12, 0.2);
+        soup.insert(5, [Vec3::ZERO, Vec3::X, Vec3::X]);
+        let positions: Vec<Vec3> = soup.iter().flatten().copied().collect();
+        let indices: Vec<[u32; 3]> = (0..soup.len() as u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect();
+        let build = |mesh_from: usize| {
+            let mut b = SceneBuilder::new();
+            let grey = b.material(Material::diffuse(Vec3::splat(0.7)));
+            let red = b.material(Material::diffuse(Vec3::new(0.8, 0.2, 0.1)));
+            let materials = (0..indices.len()).map(|i| [grey, red][i % 2]).collect();
+            b.indexed_mesh(positions.clone(), indices.clone(), materials);
+            b.drop_degenerate();
+            b.light(PointLight {
+                position: Vec3::new(0.3, -0.8, -2.5),
+                power: Vec3::splat(14.0),
+            });
+            b.mesh_from = Some(mesh_from);
+            b.build("mesh", Camera::default(), Effects::SEED).unwrap()
+        };
+        let (list, mesh) = (build(usize::MAX), build(0));
+        assert!(mesh.triangles().is_empty() && mesh.mesh.is_some());
+        assert_eq!(list.triangle_count(), soup.len() - 1);
+        assert_eq!(mesh.triangle_count(), list.triangle_count());
+        for i in 0..list.triangle_count() as u32 {
+            assert_eq!(mesh.triangle(i), list.triangle(i), "triangle {i}");
+            assert_eq!(mesh.material_of(i), list.material_of(i), "triangle {i}");
+        }
+        assert_eq!(mesh.centre(), list.centre());
+        let frame = |s: &Scene| {
+            s.render(&crate::Options {
+                width: 48,
+                height: 32,
+                ..crate::Options::default()
+            })
+            .image
+            .pixels
+            .iter()
+            .map(|p| p.to_array().map(f32::to_bits))
+            .collect::<Vec<_>>()
+        };
+        let f = frame(&list);
+        assert!(f.iter().any(|p| p != &[0; 3]), "the frame shows the sphere");
+        assert_eq!(frame(&mesh), f);
+    }
+}

@@ -188,7 +188,7 @@ impl<'a> Tracer<'a> {
         rng: &mut impl SampleSource,
         n: &mut RayCounts,
     ) -> SplitSample {
-        let tri = &self.scene.triangles()[hit.triangle as usize];
+        let tri = &self.scene.triangle(hit.triangle);
         let material = &self.scene.materials()[tri.material as usize];
         if self.settings.mode != Mode::Colour {
             return SplitSample {
@@ -317,7 +317,7 @@ impl<'a> Tracer<'a> {
         rng: &mut impl SampleSource,
         n: &mut RayCounts,
     ) -> Vec3 {
-        let tri = &self.scene.triangles()[hit.triangle as usize];
+        let tri = &self.scene.triangle(hit.triangle);
         let material = &self.scene.materials()[tri.material as usize];
         let colour = self.scene.base_colour(hit.triangle, hit.b);
         if self.settings.mode == Mode::Flat {
@@ -420,8 +420,7 @@ impl<'a> Tracer<'a> {
     /// flat colour are shaded one ray at a time.
     #[inline]
     fn in_lanes(&self, triangle: u32) -> bool {
-        let tri = &self.scene.triangles()[triangle as usize];
-        let material = &self.scene.materials()[tri.material as usize];
+        let material = &self.scene.materials()[self.scene.material_of(triangle) as usize];
         match self.settings.mode {
             Mode::Flat => false,
             Mode::Irradiance => true,
@@ -436,7 +435,7 @@ impl<'a> Tracer<'a> {
     fn culls(&self) -> Option<&[crate::accel::shadow::ShadowCull]> {
         use crate::accel::shadow::{SHADOW_TILE_TRIANGLES, ShadowCull};
         let tris = self.scene.triangles();
-        if !self.settings.effects.shadows || tris.len() > SHADOW_TILE_TRIANGLES {
+        if !self.settings.effects.shadows || self.scene.triangle_count() > SHADOW_TILE_TRIANGLES {
             return None;
         }
         let culls = self.culls.get_or_init(|| {
@@ -461,7 +460,7 @@ impl<'a> Tracer<'a> {
         matches!(
             self.scene.isa(),
             crate::simd::Isa::Avx2 | crate::simd::Isa::Avx512
-        ) && self.scene.triangles().len() <= crate::accel::shadow::SHADOW_TILE_TRIANGLES
+        ) && self.scene.triangle_count() <= crate::accel::shadow::SHADOW_TILE_TRIANGLES
     }
 
     /// [`Tracer::shade_tile`] of hits in lanes as [`crate::Scene::intersect_tile_best`] leaves
@@ -513,7 +512,7 @@ pub struct TileScratch {
 /// The hit of `ray` at `hit` in `scene`: the tile kernel's [`surface`] at width 1, with the
 /// scene's shading normal there.
 fn surface_of(scene: &Scene, hit: &Hit, ray: &Ray) -> Surface<f32> {
-    let tri: &Triangle = &scene.triangles()[hit.triangle as usize];
+    let tri: &Triangle = &scene.triangle(hit.triangle);
     let v = tri.v.map(|v| v.to_array());
     let mut at = surface(Scalar, v, tri.normal.to_array(), hit.b, ray.dir.to_array());
     if let Some(n) = scene.shading_normal(hit.triangle, hit.b) {

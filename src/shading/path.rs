@@ -246,7 +246,6 @@ impl Tracer<'_> {
             _ => 0,
         };
         let scene = self.scene;
-        let tris = scene.triangles();
         let mis = self.estimator;
         let smooth = self.smooth;
         // [sharp, soft] (see `PathColour`).
@@ -266,7 +265,7 @@ impl Tracer<'_> {
             // delta lights (the first vertex's are exact: sharp).
             let soft = usize::from(!focused);
             let exact = if vertex == 0 { 0 } else { soft };
-            let tri = &tris[hit.triangle as usize];
+            let tri = &scene.triangle(hit.triangle);
             let material = &scene.materials()[tri.material as usize];
             let at = surface_of(scene, &hit, &ray);
             let p = Vec3::from_array(at.p);

@@ -15,7 +15,7 @@ use super::surface::{Surface, surface, with_shading};
 use super::{Mode, RayCounts, SHADOW_EPSILON, Tracer};
 use crate::accel::TILE_RAYS;
 use crate::accel::tri4::Best8;
-use crate::geometry::{Ray, RayTile};
+use crate::geometry::{Ray, RayTile, Triangle};
 use crate::scene::{DirectionalLight, Indirect, PointLight, SpotLight};
 
 /// Most pixels in a tile.
@@ -29,6 +29,17 @@ pub(crate) type Block = [f32; 8];
 fn block(a: &[f32], o: usize) -> &Block {
     a[o..o + 8].try_into().expect("eight lanes")
 }
+
+/// `0, 1, 2, …`: pixel `j` on the `j`-th of a tile's triangles rebuilt (see `shade_lanes`).
+static PIXEL_ORDER: [u32; N] = {
+    let mut order = [0; N];
+    let mut j = 0;
+    while j < N {
+        order[j] = j as u32;
+        j += 1;
+    }
+    order
+};
 
 /// The pixels of a tile gathered for the kernel, packed in order.
 #[derive(Clone, Debug)]
@@ -288,7 +299,6 @@ impl Tracer<'_> {
         if m == 0 {
             return;
         }
-        let tris = self.scene.triangles();
         let dirs = rays.dir_lanes();
         let chunks = m.div_ceil(w);
         // Lanes past the last pixel repeat it (its triangle, index and barycentrics), so that
@@ -302,6 +312,21 @@ impl Tracer<'_> {
                 g.b[a][j] = g.b[a][last];
             }
         }
+        // Pixel `j`'s triangle is `tris[tri_of[j]]`. A big model keeps no list of triangles
+        // (`Scene::triangle`): the tile's are rebuilt here, once each, in pixel order.
+        // (Scenes with a list are read in place: copying triangles out of it cost the seed's
+        // frame 8 % more instructions.)
+        let rebuilt: Vec<Triangle>;
+        let (tris, tri_of) = match self.scene.triangles() {
+            [] => {
+                rebuilt = g.tri[..end]
+                    .iter()
+                    .map(|&t| self.scene.triangle(t))
+                    .collect();
+                (rebuilt.as_slice(), &PIXEL_ORDER)
+            }
+            list => (list, &g.tri),
+        };
         // Bit `c`: the pixels of block `c` are all on one triangle (the common case): its
         // values are splatted, else gathered lane by lane.
         let mut same = 0u64;
@@ -316,9 +341,9 @@ impl Tracer<'_> {
         for c in 0..chunks {
             let o = c * w;
             let count = (m - o).min(w);
-            let first = &tris[g.tri[o] as usize];
+            let first = &tris[tri_of[o] as usize];
             let same = same >> c & 1 == 1;
-            let tri = |l: usize| &tris[g.tri[o + l] as usize];
+            let tri = |l: usize| &tris[tri_of[o + l] as usize];
             let v = each3!(|j| each3!(|a| match same {
                 true => s.splat(first.v[j][a]),
                 false => s.gather(|l| tri(l).v[j][a]),
@@ -345,7 +370,7 @@ impl Tracer<'_> {
                     let t = g.tri[j];
                     self.scene
                         .shading_normal(t, b)
-                        .unwrap_or(tris[t as usize].normal)
+                        .unwrap_or_else(|| tri(l.min(w - 1)).normal)
                 });
                 with_shading(s, &mut at, each3!(|a| s.gather(|l| ns[l][a])));
                 let sh = &mut pts.shading[bi];

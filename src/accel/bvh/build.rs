@@ -13,7 +13,7 @@ mod morton;
 use bins::{Binning, Bounds, Grow, NodeBounds, PrimRef, bin_all};
 
 use super::{MAX_DEPTH, Node, NodePair};
-use crate::geometry::Triangle;
+use crate::accel::Vertices;
 
 /// Number of SAH bins per axis.
 pub const SAH_BINS: usize = 16;
@@ -56,12 +56,7 @@ const PARALLEL_PASS: usize = 64 * 1024;
 /// Chunk size for the parallel passes.
 const CHUNK: usize = 16 * 1024;
 
-/// Trees over at least this many triangles build their lower levels as a linear BVH
-/// (`morton.rs`): nodes of at most [`MORTON_NODE`] triangles. Smaller trees (every built-in
-/// scene: the 1M sphere has 1,003,552 triangles) are binned SAH all the way down.
-pub const BIG_TREE: usize = 1 << 21;
-
-/// In a big tree, nodes of at most this many triangles are built by `morton.rs`. The 10M-triangle
+/// In a fast build, nodes of at most this many triangles are built by `morton.rs`. The 10M-triangle
 /// torus of `examples/big_ply.rs` (`render --pixels 1x1`, one thread): its binary tree built in
 /// 6.3 s by SAH alone, 2.7 s with Morton subtrees of up to 64K, 2.2 s up to 1M; its 300×300
 /// frame traced in 41 ms through the SAH tree, 60-70 ms through these (a machine under load).
@@ -93,24 +88,20 @@ pub(super) struct Built {
 }
 
 /// Builds the hierarchy over `triangles`: binned SAH, or with `morton` nodes of at most that
-/// many triangles built as a linear BVH (see [`BIG_TREE`]).
-pub(super) fn build(triangles: &[Triangle], morton: Option<usize>) -> Built {
-    if triangles.is_empty() {
+/// many triangles built as a linear BVH.
+pub(super) fn build(triangles: &(impl Vertices + ?Sized), morton: Option<usize>) -> Built {
+    if triangles.count() == 0 {
         return Built {
             pairs: Vec::new(),
             order: Vec::new(),
             depth: 0,
         };
     }
-    let mut refs: Vec<PrimRef> = triangles
-        .par_iter()
-        .enumerate()
-        .map(|(i, t)| {
-            PrimRef::new(
-                t.v[0].min(t.v[1]).min(t.v[2]),
-                t.v[0].max(t.v[1]).max(t.v[2]),
-                i as u32,
-            )
+    let mut refs: Vec<PrimRef> = (0..triangles.count())
+        .into_par_iter()
+        .map(|i| {
+            let v = triangles.vertices(i);
+            PrimRef::new(v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]), i as u32)
         })
         .collect();
     let nb = NodeBounds::of(&refs);

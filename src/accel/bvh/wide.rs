@@ -4,9 +4,10 @@
 //! [`Tri4`] blocks, leaves in depth-first order too.
 
 use super::node::{Node, NodePair};
+use crate::accel::Vertices;
 use crate::accel::box8::{BOX_LANES, Box8};
 use crate::accel::tri4::{LANES, Tri4};
-use crate::geometry::{Aabb, Triangle};
+use crate::geometry::Aabb;
 
 /// Children per node at most. (Four was measured too: see the issue notes.)
 pub const WIDTH: usize = BOX_LANES;
@@ -58,7 +59,11 @@ pub(super) struct Collapsed {
 /// children keep the binary tree's left-to-right order. Deterministic: it depends only on the
 /// binary tree. (Laying out the top levels' subtrees in parallel and joining them was tried:
 /// copying the joined blocks cost what the second thread saved.)
-pub(super) fn collapse(pairs: &[NodePair], order: &[u32], triangles: &[Triangle]) -> Collapsed {
+pub(super) fn collapse<V: Vertices + ?Sized>(
+    pairs: &[NodePair],
+    order: &[u32],
+    triangles: &V,
+) -> Collapsed {
     let n_blocks: usize = pairs
         .iter()
         .flat_map(|p| p.0.iter().map(|n| (n.count as usize).div_ceil(LANES)))
@@ -82,10 +87,10 @@ pub(super) fn collapse(pairs: &[NodePair], order: &[u32], triangles: &[Triangle]
 }
 
 /// The binary tree being collapsed.
-struct Tree<'a> {
+struct Tree<'a, V: ?Sized> {
     pairs: &'a [NodePair],
     order: &'a [u32],
-    triangles: &'a [Triangle],
+    triangles: &'a V,
 }
 
 fn area(n: &Node) -> f64 {
@@ -93,7 +98,7 @@ fn area(n: &Node) -> f64 {
     2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
 }
 
-impl Tree<'_> {
+impl<V: Vertices + ?Sized> Tree<'_, V> {
     fn node(&self, i: usize) -> Node {
         self.pairs[i / 2].0[i % 2]
     }
@@ -151,7 +156,7 @@ impl Tree<'_> {
             for chunk in leaf.chunks(LANES) {
                 let mut v = [[glam::Vec3::ZERO; 3]; LANES];
                 for (v, &t) in v.iter_mut().zip(chunk) {
-                    *v = self.triangles[t as usize].v;
+                    *v = self.triangles.vertices(t as usize);
                 }
                 c.blocks.push(Tri4::new(&v[..chunk.len()]));
             }

@@ -319,8 +319,8 @@ impl Model {
         let scene = b
             .build(name, camera, effects)
             .map_err(|e| SceneFileError::whole_file(file, e.to_string()))?;
-        let dropped = triangles - scene.triangles().len();
-        if scene.triangles().is_empty() {
+        let dropped = triangles - scene.triangle_count();
+        if scene.triangle_count() == 0 {
             return Err(SceneFileError::whole_file(
                 file,
                 format!("all {triangles} triangles have zero area: nothing to show"),
