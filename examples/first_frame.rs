@@ -46,7 +46,13 @@ fn main() {
     let mut times = Vec::new();
     for run in 0..runs {
         let start = Instant::now();
-        let link = SlowLink::start(binary, &[model, "--color", "truecolor"], COLS, ROWS, 1e9);
+        let link = SlowLink::start_behind_buffer(
+            binary,
+            &[model, "--color", "truecolor"],
+            COLS,
+            ROWS,
+            1e9,
+        );
         let shown = link.wait_for(Duration::from_secs(60), |s| {
             painted(s) >= (COLS as usize * ROWS as usize) / 2
         });
