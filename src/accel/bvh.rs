@@ -397,7 +397,7 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .unwrap()
-                .install(|| Bvh::build(&tris))
+                .install(|| Bvh::build(&tris[..]))
         };
         let one = build(1);
         assert!(one.depth() as usize <= MAX_DEPTH);
@@ -421,11 +421,14 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .unwrap()
-                .install(|| Bvh::build_with(&tris, Some(20_000)))
+                .install(|| Bvh::build_with(&tris[..], Some(20_000)))
         };
         let one = build(1);
         assert!(one.depth() as usize <= MAX_DEPTH);
-        assert!(one != Bvh::build(&tris), "the Morton levels were not built");
+        assert!(
+            one != Bvh::build(&tris[..]),
+            "the Morton levels were not built"
+        );
         for threads in [2, 3] {
             assert!(
                 build(threads) == one,
@@ -478,7 +481,7 @@ mod tests {
     #[test]
     fn leaves_hold_a_few_triangles() {
         let tris = triangles(displaced_icosphere(30, 0.1));
-        let bvh = Bvh::build(&tris);
+        let bvh = Bvh::build(&tris[..]);
         let per_leaf = tris.len() as f64 / bvh.leaves() as f64;
         assert!(
             (1.0..=LEAF_MAX as f64).contains(&per_leaf),
@@ -510,7 +513,7 @@ mod tests {
                 .into_iter()
                 .filter_map(|v| Triangle::new(v[0], v[1], v[2], 0).ok())
                 .collect();
-            let bvh = Bvh::build(&tris);
+            let bvh = Bvh::build(&tris[..]);
             assert!(
                 bvh.wide_nodes() <= bvh.nodes() / 2,
                 "{n} triangles: {} wide nodes for {} binary",

@@ -137,18 +137,6 @@ impl Vertices for [Triangle] {
     }
 }
 
-impl Vertices for Vec<Triangle> {
-    #[inline]
-    fn count(&self) -> usize {
-        self.len()
-    }
-
-    #[inline]
-    fn vertices(&self, i: usize) -> [glam::Vec3; 3] {
-        self[i].v
-    }
-}
-
 impl Default for Accel {
     fn default() -> Accel {
         Accel::build_kind(&[], &[], AccelKind::Flat)

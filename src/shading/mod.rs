@@ -507,6 +507,8 @@ pub struct TileScratch {
     gathered: Box<tile::Gathered>,
     points: Box<tile::Points<{ crate::accel::TILE_RAYS / 8 }>>,
     shadows: tile::ShadowScratch,
+    /// A big model's tile triangles, rebuilt from its mesh (see [`Tracer::shade_tile`]).
+    triangles: Vec<Triangle>,
 }
 
 /// The hit of `ray` at `hit` in `scene`: the tile kernel's [`surface`] at width 1, with the

@@ -15,7 +15,7 @@ use super::surface::{Surface, surface, with_shading};
 use super::{Mode, RayCounts, SHADOW_EPSILON, Tracer};
 use crate::accel::TILE_RAYS;
 use crate::accel::tri4::Best8;
-use crate::geometry::{Ray, RayTile, Triangle};
+use crate::geometry::{Ray, RayTile};
 use crate::scene::{DirectionalLight, Indirect, PointLight, SpotLight};
 
 /// Most pixels in a tile.
@@ -316,13 +316,11 @@ impl Tracer<'_> {
         // (`Scene::triangle`): the tile's are rebuilt here, once each, in pixel order.
         // (Scenes with a list are read in place: copying triangles out of it cost the seed's
         // frame 8 % more instructions.)
-        let rebuilt: Vec<Triangle>;
+        let rebuilt = &mut scratch.triangles;
         let (tris, tri_of) = match self.scene.triangles() {
             [] => {
-                rebuilt = g.tri[..end]
-                    .iter()
-                    .map(|&t| self.scene.triangle(t))
-                    .collect();
+                rebuilt.clear();
+                rebuilt.extend(g.tri[..end].iter().map(|&t| self.scene.triangle(t)));
                 (rebuilt.as_slice(), &PIXEL_ORDER)
             }
             list => (list, &g.tri),
@@ -406,8 +404,9 @@ impl Tracer<'_> {
                     let mut rho = [Vec3::ZERO; 8];
                     for (l, rho) in rho[..if one { 1 } else { w }].iter_mut().enumerate() {
                         let j = o + l;
-                        *rho =
-                            (self.scene).base_colour(g.tri[j], [g.b[0][j], g.b[1][j], g.b[2][j]]);
+                        *rho = self
+                            .scene
+                            .base_colour(g.tri[j], [g.b[0][j], g.b[1][j], g.b[2][j]]);
                     }
                     let rho = match one {
                         true => each3!(|a| s.splat(rho[0][a])),
