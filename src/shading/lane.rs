@@ -333,14 +333,20 @@ mod x86 {
         }
         #[inline(always)]
         fn step_along(self, v: __m256, off: __m256) -> __m256 {
+            // Both steps from `v` itself (a lane takes one of them at most), so that they
+            // share its comparisons.
             unsafe {
                 let zero = _mm256_setzero_ps();
-                let v = _mm256_blendv_ps(
+                let down = _mm256_blendv_ps(
                     v,
                     Self::next_down(v),
                     _mm256_cmp_ps::<_CMP_LT_OQ>(off, zero),
                 );
-                _mm256_blendv_ps(v, Self::next_up(v), _mm256_cmp_ps::<_CMP_GT_OQ>(off, zero))
+                _mm256_blendv_ps(
+                    down,
+                    Self::next_up(v),
+                    _mm256_cmp_ps::<_CMP_GT_OQ>(off, zero),
+                )
             }
         }
     }

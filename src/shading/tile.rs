@@ -219,10 +219,29 @@ impl Tracer<'_> {
         self.shade_lanes(s, rays, best, out, n, scratch)
     }
 
-    /// The kernel (see the module's doc), inlined into each entry.
+    /// The kernel (see the module's doc), inlined into each entry: compiled once for scenes
+    /// with shading normals and once for scenes without, which then pay nothing for them (the
+    /// seed frame's instructions −2 %, callgrind).
+    #[inline(always)]
+    fn shade_lanes<S: Lanes>(
+        &self,
+        s: S,
+        rays: &RayTile,
+        best: &[Best8; N / 8],
+        out: &mut [Vec3],
+        n: &mut RayCounts,
+        scratch: &mut super::TileScratch,
+    ) {
+        match self.smooth {
+            true => self.shade_lanes_as::<S, true>(s, rays, best, out, n, scratch),
+            false => self.shade_lanes_as::<S, false>(s, rays, best, out, n, scratch),
+        }
+    }
+
+    /// [`Tracer::shade_lanes`] where `SMOOTH` is whether the scene has shading normals.
     #[inline(always)]
     #[allow(clippy::needless_range_loop)] // lanes, blocks and axes, in step across arrays
-    fn shade_lanes<S: Lanes>(
+    fn shade_lanes_as<S: Lanes, const SMOOTH: bool>(
         &self,
         s: S,
         rays: &RayTile,
@@ -327,20 +346,13 @@ impl Tracer<'_> {
         };
         // Bit `c`: the pixels of block `c` are all on one triangle (the common case): its
         // values are splatted, else gathered lane by lane.
-        let mut same = 0u64;
-        for c in 0..chunks {
-            let o = c * w;
-            let one = match w {
-                1 => true,
-                _ => g.tri[o..o + 8] == [g.tri[o]; 8],
-            };
-            same |= (one as u64) << c;
-        }
+        let mut same_bits = 0u64;
         for c in 0..chunks {
             let o = c * w;
             let count = (m - o).min(w);
             let first = &tris[tri_of[o] as usize];
-            let same = same >> c & 1 == 1;
+            let same = w == 1 || g.tri[o..o + 8] == [g.tri[o]; 8];
+            same_bits |= (same as u64) << c;
             let tri = |l: usize| &tris[tri_of[o + l] as usize];
             let v = each3!(|j| each3!(|a| match same {
                 true => s.splat(first.v[j][a]),
@@ -360,7 +372,7 @@ impl Tracer<'_> {
             let b = each3!(|a| s.load(block(&g.b[a], o)));
             let mut at = surface(s, v, normal, b, dir);
             let (bi, ai) = (o / 8, o % 8);
-            if self.smooth {
+            if SMOOTH {
                 // Each pixel's interpolated vertex normal (the triangle's where it has none).
                 let ns: [Vec3; 8] = std::array::from_fn(|l| {
                     let j = o + l.min(w - 1);
@@ -382,7 +394,7 @@ impl Tracer<'_> {
             });
         }
         let shadows = self.tile_shadows(s);
-        self.add_lights(s, pts, m, shadows, &mut scratch.shadows, n);
+        self.add_lights(s, pts, m, SMOOTH, shadows, &mut scratch.shadows, n);
         let indirect = match self.settings.effects.indirect {
             Indirect::Constant(k) => k,
             _ => 0.0,
@@ -391,6 +403,7 @@ impl Tracer<'_> {
         // Whether a triangle's colour changes across it (vertex colours, textures): then each
         // pixel's is looked up, even where a block's pixels share a triangle.
         let varies = self.scene.colour_varies();
+        let materials = self.scene.materials();
         for c in 0..chunks {
             let o = c * w;
             let count = (m - o).min(w);
@@ -398,19 +411,28 @@ impl Tracer<'_> {
             let sum = each3!(|a| s.load_at(&sum[a], o % 8));
             let colour = match self.settings.mode {
                 Mode::Colour => {
-                    // Each pixel's base colour, looked up once (one lookup where the block's
-                    // pixels are on one triangle of one colour).
-                    let one = same >> c & 1 == 1 && !varies;
-                    let mut rho = [Vec3::ZERO; 8];
-                    for (l, rho) in rho[..if one { 1 } else { w }].iter_mut().enumerate() {
-                        let j = o + l;
-                        *rho = self
-                            .scene
-                            .base_colour(g.tri[j], [g.b[0][j], g.b[1][j], g.b[2][j]]);
-                    }
-                    let rho = match one {
-                        true => each3!(|a| s.splat(rho[0][a])),
-                        false => each3!(|a| s.gather(|l| rho[l][a])),
+                    // Each pixel's base colour: its material's where colours do not vary
+                    // across triangles (one lookup where the block's pixels share a triangle),
+                    // else looked up at the pixel.
+                    let tri = |l: usize| &tris[tri_of[o + l] as usize];
+                    let rho = if varies {
+                        let mut rho = [Vec3::ZERO; 8];
+                        for (l, rho) in rho[..w].iter_mut().enumerate() {
+                            let j = o + l;
+                            *rho = self
+                                .scene
+                                .base_colour(g.tri[j], [g.b[0][j], g.b[1][j], g.b[2][j]]);
+                        }
+                        each3!(|a| s.gather(|l| rho[l][a]))
+                    } else if same_bits >> c & 1 == 1 {
+                        let rho = materials[tri(0).material as usize].colour;
+                        each3!(|a| s.splat(rho[a]))
+                    } else {
+                        let mut rho = [Vec3::ZERO; 8];
+                        for (l, rho) in rho[..w].iter_mut().enumerate() {
+                            *rho = materials[tri(l).material as usize].colour;
+                        }
+                        each3!(|a| s.gather(|l| rho[l][a]))
                     };
                     super::diffuse(s, rho, sum, [s.splat(indirect); 3])
                 }
@@ -456,6 +478,7 @@ impl Tracer<'_> {
             Scalar,
             &mut pts,
             1,
+            self.smooth,
             Shadows::Scene,
             &mut ShadowScratch::default(),
             n,
@@ -463,15 +486,18 @@ impl Tracer<'_> {
         Points::at(&pts.sum, 0)
     }
 
-    /// The sums over the lights at the first `m` points of `pts` (their surfaces computed):
-    /// light by light, each point's term where the light reaches it and no shadow ray is
-    /// blocked (the tile's shadow rays toward a light traced together, as `shadows` says).
+    /// The sums over the lights at the first `m` points of `pts` (their surfaces computed,
+    /// with shading normals if `smooth`): light by light, each point's term where the light
+    /// reaches it and no shadow ray is blocked (the tile's shadow rays toward a light traced
+    /// together, as `shadows` says).
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn add_lights<S: Lanes, const B: usize>(
         &self,
         s: S,
         pts: &mut Points<B>,
         m: usize,
+        smooth: bool,
         shadows: Shadows,
         scratch: &mut ShadowScratch,
         n: &mut RayCounts,
@@ -486,7 +512,8 @@ impl Tracer<'_> {
             if light.power == Vec3::ZERO {
                 continue;
             }
-            self.add_light(s, pts, m, Delta::Point(light), shadows, li, scratch, n);
+            let light = Delta::Point(light);
+            self.add_light(s, pts, m, smooth, light, shadows, li, scratch, n);
         }
         // The other delta lights: no shadow cull of their own, so their rays go through the
         // scene's structure.
@@ -495,14 +522,14 @@ impl Tracer<'_> {
                 continue;
             }
             let light = Delta::Directional(light);
-            self.add_light(s, pts, m, light, Shadows::Scene, 0, scratch, n);
+            self.add_light(s, pts, m, smooth, light, Shadows::Scene, 0, scratch, n);
         }
         for light in self.scene.spot_lights() {
             if light.power == Vec3::ZERO {
                 continue;
             }
             let light = Delta::Spot(light);
-            self.add_light(s, pts, m, light, Shadows::Scene, 0, scratch, n);
+            self.add_light(s, pts, m, smooth, light, Shadows::Scene, 0, scratch, n);
         }
         // Frames that trace no random ray take the environment unshadowed, as the seed's
         // constant N (path-traced ones find it where their rays leave the scene).
@@ -529,6 +556,7 @@ impl Tracer<'_> {
         s: S,
         pts: &mut Points<B>,
         m: usize,
+        smooth: bool,
         light: Delta,
         shadows: Shadows,
         li: usize,
@@ -542,10 +570,10 @@ impl Tracer<'_> {
         let (mut lit, mut traced) = (0u64, 0u64);
         for c in 0..chunks {
             let o = c * w;
-            let at = pts.surface(s, o, self.smooth);
+            let at = pts.surface(s, o, smooth);
             // (A match, not a closure: a closure would not be compiled with the kernel's
             // target features, and the lane functions would not inline into it.)
-            let (shadows_on, smooth) = (self.settings.effects.shadows, self.smooth);
+            let shadows_on = self.settings.effects.shadows;
             let inc = match light {
                 Delta::Point(l) => point_light(s, l, self.min_r2, &at, shadows_on, smooth),
                 Delta::Directional(l) => {
