@@ -18,7 +18,21 @@ pub struct AreaLights {
     emitters: Vec<Emitter>,
     /// Picks a position in `triangles` by power (emission summed over the channels × area).
     table: AliasTable,
+    /// How many candidates a light sample draws to keep one (see [`AreaLights::candidates`]).
+    candidates: usize,
 }
+
+/// The most candidates a light sample can draw ([`AreaLights::candidates`]).
+pub const MAX_CANDIDATES: usize = 4;
+
+/// Candidates drawn where emitters face different ways. On the plates (four emitting balls,
+/// 160x100, 1024 spp, values clamped, against Mitsuba 3's 16384-spp frame, CPU of a 2-thread
+/// run): RMSE 0.00505 -> 0.00433 for 12 % more CPU (callgrind: +24 % instructions), time x
+/// MSE 0.82x; four: RMSE 0.00405 for 33 % more (0.85x), eight 0.00389 for 87 % more.
+const FACING_CANDIDATES: usize = 2;
+
+/// Emitters whose front normals agree this closely face one way.
+const SAME_WAY: f32 = 1.0 - 1e-5;
 
 /// An emitting triangle as [`AreaLights::sample`] reads it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,6 +84,9 @@ impl AreaLights {
             }
         }
         let table = AliasTable::new(&power)?;
+        let one_way = emitters
+            .iter()
+            .all(|e| e.front.dot(emitters[0].front) >= SAME_WAY);
         for (k, em) in emitters.iter_mut().enumerate() {
             // A triangle of zero area has zero power: never picked, and no density.
             let area = triangle_area(&em.v);
@@ -79,7 +96,18 @@ impl AreaLights {
             triangles: ids,
             emitters,
             table,
+            candidates: if one_way { 1 } else { FACING_CANDIDATES },
         })
+    }
+
+    /// How many candidates a light sample draws, of which it keeps one by what each would
+    /// bring (resampled importance sampling, `shading::light::area_light`): one where every
+    /// emitter faces the same way (a flat light, whose triangles a point sees all from the
+    /// front or all from behind), else more, so that a sample seldom lands on an emitter
+    /// facing away from the point (the far side of an emitting ball: half of its area) or
+    /// outside a glossy lobe.
+    pub fn candidates(&self) -> usize {
+        self.candidates
     }
 
     /// How many triangles emit.

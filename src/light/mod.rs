@@ -10,4 +10,4 @@ mod emitters;
 
 pub use alias::AliasTable;
 pub use area::{TrianglePoint, area_to_solid_angle, sample_triangle};
-pub use emitters::{AreaLights, LightPoint};
+pub use emitters::{AreaLights, LightPoint, MAX_CANDIDATES};

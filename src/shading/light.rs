@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 use super::lane::{Lanes, Scalar, each3};
 use super::surface::{Surface, dot, offset_origin};
 use crate::geometry::Ray;
-use crate::light::AreaLights;
+use crate::light::{AreaLights, MAX_CANDIDATES};
 use crate::scene::{DirectionalLight, PointLight, SpotLight};
 
 /// The kinds of light a frame ran besides point lights and emitting triangles (for `render
@@ -45,8 +45,14 @@ impl LightEffects {
 pub(crate) struct AreaIncident {
     /// The unit direction toward it.
     pub wi: Vec3,
-    /// The density per solid angle of having drawn it.
+    /// What an estimate divides by: the density per solid angle of having drawn it, or
+    /// where it was resampled from several candidates, an unbiased estimate's reciprocal
+    /// (see [`area_light`]).
     pub pdf: f32,
+    /// The density per solid angle with which one candidate lands on it (by power, then by
+    /// area): what multiple importance sampling weighs against the BSDF's density, at the
+    /// vertex that samples the light and at one whose BSDF ray finds it alike.
+    pub candidate_pdf: f32,
     /// What its front face emits toward the point.
     pub emission: Vec3,
     /// The shadow ray: from the offset point to the light point, blocked if anything is hit
@@ -54,34 +60,100 @@ pub(crate) struct AreaIncident {
     pub shadow: Ray,
 }
 
-/// One of `lights` picked by power and a point on it by area, both from `u`
-/// ([`AreaLights::sample`]), seen from the point `at`: `None` where the light's back faces the point or is edge-on (it sends nothing
-/// there, and no shadow ray is traced).
-pub(crate) fn area_light(lights: &AreaLights, at: &Surface<f32>, u: Vec2) -> Option<AreaIncident> {
-    let lp = lights.sample(u)?;
+/// A point on `lights` for the point `at`, from `candidates` (at most
+/// [`crate::light::MAX_CANDIDATES`]) drawn by power and area. One candidate is one of `lights`
+/// picked by power and a point on it by area ([`AreaLights::sample`]) from `u`. Several are
+/// resampled (resampled importance sampling, Talbot, Cline and Egbert 2005): candidate `j`
+/// is drawn from `u` shifted by `(j/candidates, j·φ)` modulo 1 (a Cranley-Patterson rotation:
+/// each is uniform, and together they spread over the lights), and one is kept by `u_pick`
+/// in proportion to `target(wi, emission)` over its density. `target` should follow what
+/// the candidate would bring (the BSDF's value times the emission and the cosine,
+/// unshadowed), and may be zero only where that is. The kept point's `pdf` is then
+/// `target / mean weight`, whose reciprocal is an unbiased estimate of the one a density
+/// would give: a candidate on the back of an emitting ball or outside a glossy lobe is
+/// seldom kept. `None` where no candidate can bring anything (no shadow ray is traced).
+pub(crate) fn area_light(
+    lights: &AreaLights,
+    at: &Surface<f32>,
+    candidates: usize,
+    u: Vec2,
+    u_pick: f32,
+    target: impl Fn(Vec3, Vec3) -> f32,
+) -> Option<AreaIncident> {
     let p = Vec3::from_array(at.p);
-    let d = lp.position - p;
-    // Only the light's front face emits; edge-on or on the point, it sends nothing.
-    let cos_d = -d.dot(lp.front);
-    if !(cos_d > 0.0) {
+    let m = candidates.clamp(1, MAX_CANDIDATES);
+    // Each candidate: the point, its direction, density, target and weight.
+    let mut drawn = [None; MAX_CANDIDATES];
+    let mut total = 0.0;
+    for (j, c) in drawn[..m].iter_mut().enumerate() {
+        let shift = Vec2::new(j as f32 / m as f32, j as f32 * CANDIDATE_STEP_Y);
+        let Some(lp) = lights.sample(Vec2::new((u.x + shift.x).fract(), (u.y + shift.y).fract()))
+        else {
+            continue;
+        };
+        let d = lp.position - p;
+        // Only the light's front face emits; edge-on or on the point, it sends nothing.
+        let cos_d = -d.dot(lp.front);
+        if !(cos_d > 0.0) {
+            continue;
+        }
+        // `area_to_solid_angle`'s `pdf_area·r²/cos θ`, with cos θ = cos_d/r.
+        let r2 = d.length_squared();
+        let r = r2.sqrt();
+        let pdf = lp.pdf_area * r2 * r / cos_d;
+        if !(pdf.is_finite() && pdf > 0.0) {
+            continue;
+        }
+        let wi = d / r;
+        if m == 1 {
+            // One candidate: kept whatever it brings, at its own density.
+            *c = Some((lp, wi, pdf, pdf, 1.0));
+            total = 1.0;
+            break;
+        }
+        let t = target(wi, lp.emission);
+        let w = t / pdf;
+        if !(t > 0.0 && w.is_finite()) {
+            continue;
+        }
+        total += w;
+        *c = Some((lp, wi, pdf, t, w));
+    }
+    if !(total > 0.0 && total.is_finite()) {
         return None;
     }
-    // `area_to_solid_angle`'s `pdf_area·r²/cos θ`, with cos θ = cos_d/r.
-    let r2 = d.length_squared();
-    let r = r2.sqrt();
-    let pdf = lp.pdf_area * r2 * r / cos_d;
+    // The candidate in whose share of the total weight `u_pick` falls.
+    let mut left = u_pick * total;
+    let mut kept = None;
+    for c in drawn.into_iter().flatten() {
+        kept = Some(c);
+        left -= c.4;
+        if left < 0.0 {
+            break;
+        }
+    }
+    let (lp, wi, candidate_pdf, t, _) = kept?;
+    let pdf = if m == 1 {
+        candidate_pdf
+    } else {
+        t * m as f32 / total
+    };
     if !(pdf.is_finite() && pdf > 0.0) {
         return None;
     }
-    let wi = d / r;
     let origin = Vec3::from_array(offset_origin(Scalar, at, wi.to_array()));
     Some(AreaIncident {
         wi,
         pdf,
+        candidate_pdf,
         emission: lp.emission,
         shadow: Ray::new(origin, lp.position - origin),
     })
 }
+
+/// How far each candidate's second number is shifted from the previous one's (the golden
+/// ratio's fraction: the shifts stay apart for any number of candidates).
+const CANDIDATE_STEP_Y: f32 = 0.618_034;
 
 /// One light's contribution at a [`Surface`]'s points, one per lane.
 pub(crate) struct Incident<F> {
@@ -409,5 +481,83 @@ mod tests {
             }
         }
         assert!(lit > 10_000, "only {lit} points lit");
+    }
+
+    /// Resampling from several candidates keeps the mean of one candidate's estimate and
+    /// lowers its spread where emitters face away: an emitting ball's two halves (a cube's
+    /// faces, all emitting outwards) and a flat light beside it, seen from a point below.
+    #[test]
+    fn resampled_light_samples_keep_the_mean_and_lower_the_spread() {
+        use crate::geometry::Triangle;
+        use crate::light::AreaLights;
+        let cube = |c: Vec3, h: f32| {
+            let mut t = vec![];
+            for axis in 0..3 {
+                for sign in [-1.0f32, 1.0] {
+                    let mut n = Vec3::ZERO;
+                    n[axis] = sign;
+                    let (a, b) = (
+                        n.any_orthonormal_pair().0 * h,
+                        n.any_orthonormal_pair().1 * h,
+                    );
+                    let f = c + n * h;
+                    // Counter-clockwise seen from outside: the front faces out.
+                    let quad = [f - a - b, f + a - b, f + a + b, f - a + b];
+                    for (i, j, k) in [(0, 1, 2), (0, 2, 3)] {
+                        let mut tri = Triangle::new(quad[i], quad[j], quad[k], 0).unwrap();
+                        if tri.front().dot(n) < 0.0 {
+                            tri = Triangle::new(quad[i], quad[k], quad[j], 0).unwrap();
+                        }
+                        t.push(tri);
+                    }
+                }
+            }
+            t
+        };
+        let mut tris = cube(Vec3::new(-0.6, -1.0, 0.3), 0.2);
+        tris.extend(cube(Vec3::new(0.7, -1.5, -0.2), 0.35));
+        let lights = AreaLights::new(&tris, |_| Vec3::new(1.0, 0.8, 0.5)).unwrap();
+        assert!(lights.candidates() > 1);
+        let at = surface(
+            Scalar,
+            [[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 0.0, 1.0]],
+            [0.0, -1.0, 0.0],
+            [0.3, 0.3, 0.4],
+            [0.0, 1.0, 0.0],
+        );
+        let n = Vec3::from_array(at.shading);
+        let target = |wi: Vec3, e: Vec3| (e.x + e.y + e.z) * n.dot(wi).max(0.0);
+        // The estimate of Σ emission·cos over the lights' solid angle, by each count of
+        // candidates: mean and standard deviation over seeded draws.
+        let estimate = |m: usize| {
+            let mut rng = Rng::seeded(17);
+            let k = 400_000;
+            let (mut sum, mut sq) = (0.0f64, 0.0f64);
+            for _ in 0..k {
+                let u = Vec2::new(rng.next_f32(), rng.next_f32());
+                let x = match area_light(&lights, &at, m, u, rng.next_f32(), target) {
+                    Some(i) => f64::from(target(i.wi, i.emission) / i.pdf),
+                    None => 0.0,
+                };
+                sum += x;
+                sq += x * x;
+            }
+            let mean = sum / f64::from(k);
+            (
+                mean,
+                (sq / f64::from(k) - mean * mean).sqrt(),
+                (k as f64).sqrt(),
+            )
+        };
+        let (one, one_sd, root) = estimate(1);
+        for m in [2, 4] {
+            let (mean, sd, _) = estimate(m);
+            let se = (one_sd * one_sd + sd * sd).sqrt() / root;
+            assert!(
+                (mean - one).abs() < 4.0 * se,
+                "{m}: {mean} vs {one} (se {se})"
+            );
+            assert!(sd < 0.9 * one_sd, "{m}: spread {sd} vs {one_sd}");
+        }
     }
 }

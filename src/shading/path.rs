@@ -357,12 +357,23 @@ impl Tracer<'_> {
                     && let Some(lights) = scene.area_lights()
                 {
                     for _ in 0..light_samples {
+                        let u = Vec2::from(rng.next_2d());
+                        let candidates = lights.candidates();
+                        let u_pick = if candidates > 1 { rng.next_1d() } else { 0.0 };
+                        // What a candidate would bring, unshadowed: the BSDF's value times the
+                        // emission and the cosine.
+                        let target = |wi: Vec3, emission: Vec3| {
+                            let wl = frame.to_local(wi);
+                            let f = self.f_both_sides(&bsdf, wo, wl, wi, front);
+                            f.dot(emission) * wl.z.abs()
+                        };
                         let Some(AreaIncident {
                             wi,
                             pdf,
+                            candidate_pdf,
                             emission,
                             shadow,
-                        }) = area_light(lights, &at, Vec2::from(rng.next_2d()))
+                        }) = area_light(lights, &at, candidates, u, u_pick, target)
                         else {
                             continue;
                         };
@@ -376,10 +387,11 @@ impl Tracer<'_> {
                             continue;
                         }
                         // Each of k samples: f·L·cos/(k·pdf), weighed against the BSDF's
-                        // density by the k samples' combined one.
+                        // density by the k samples' combined one (of a candidate: the density
+                        // a BSDF ray that finds the light is weighed by too).
                         let k_pdf = k * pdf;
                         let w = if mis == Estimator::Mis {
-                            power_heuristic(k_pdf, bsdf.pdf(wo, wl))
+                            power_heuristic(k * candidate_pdf, bsdf.pdf(wo, wl))
                         } else {
                             1.0
                         };
