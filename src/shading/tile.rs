@@ -30,7 +30,8 @@ fn block(a: &[f32], o: usize) -> &Block {
     a[o..o + 8].try_into().expect("eight lanes")
 }
 
-/// `0, 1, 2, …`: pixel `j` on the `j`-th of a tile's triangles rebuilt (see `shade_lanes`).
+/// `0, 1, 2, …`: the indices of a tile's pixels in place, and pixel `j` on the `j`-th of a
+/// tile's triangles rebuilt (see `shade_lanes`).
 static PIXEL_ORDER: [u32; N] = {
     let mut order = [0; N];
     let mut j = 0;
@@ -71,6 +72,8 @@ pub(crate) struct Points<const B: usize> {
     err: [[Block; 3]; B],
     normal: [[Block; 3]; B],
     shading: [[Block; 3]; B],
+    /// The base colour (colour frames only).
+    rho: [[Block; 3]; B],
     /// The sum over the lights so far.
     sum: [[Block; 3]; B],
     /// One light's term, and its shadow ray's origin and direction.
@@ -87,6 +90,7 @@ impl<const B: usize> Default for Points<B> {
             err: zero,
             normal: zero,
             shading: zero,
+            rho: zero,
             sum: zero,
             term: zero,
             origin: zero,
@@ -251,7 +255,7 @@ impl Tracer<'_> {
         scratch: &mut super::TileScratch,
     ) {
         let w = S::WIDTH;
-        let (g, pts) = (&mut scratch.gathered, &mut *scratch.points);
+        let (g, pts) = (&mut *scratch.gathered, &mut *scratch.points);
         let k = rays.len();
         debug_assert!(k <= N);
         // The pixels shaded here, packed in order; the others one at a time.
@@ -282,8 +286,7 @@ impl Tracer<'_> {
             };
             // Eight pixels all shaded here (most packets): copied as they are.
             if own == 0xff {
-                g.idx[m..m + 8]
-                    .copy_from_slice(&std::array::from_fn::<u32, 8, _>(|l| (8 * c + l) as u32));
+                g.idx[m..m + 8].copy_from_slice(&PIXEL_ORDER[8 * c..8 * c + 8]);
                 g.tri[m..m + 8].copy_from_slice(ids);
                 for a in 0..3 {
                     g.b[a][m..m + 8].copy_from_slice(&bary[a]);
@@ -344,15 +347,19 @@ impl Tracer<'_> {
             }
             list => (list, &g.tri),
         };
-        // Bit `c`: the pixels of block `c` are all on one triangle (the common case): its
-        // values are splatted, else gathered lane by lane.
-        let mut same_bits = 0u64;
+        // Colour frames look each pixel's base colour up here, where its triangle is at hand:
+        // its material's where colours do not vary across triangles, else at the pixel
+        // (vertex colours, textures).
+        let colour = self.settings.mode == Mode::Colour;
+        let varies = self.scene.colour_varies();
+        let materials = self.scene.materials();
         for c in 0..chunks {
             let o = c * w;
             let count = (m - o).min(w);
             let first = &tris[tri_of[o] as usize];
+            // The pixels are all on one triangle (the common case): its values are splatted,
+            // else gathered lane by lane.
             let same = w == 1 || g.tri[o..o + 8] == [g.tri[o]; 8];
-            same_bits |= (same as u64) << c;
             let tri = |l: usize| &tris[tri_of[o + l] as usize];
             let v = each3!(|j| each3!(|a| match same {
                 true => s.splat(first.v[j][a]),
@@ -392,6 +399,29 @@ impl Tracer<'_> {
                 s.store_at(&mut err[a], ai, at.err[a]);
                 s.store_at(&mut nn[a], ai, at.normal[a]);
             });
+            if colour {
+                let rho = if varies {
+                    let mut rho = [Vec3::ZERO; 8];
+                    for (l, rho) in rho[..w].iter_mut().enumerate() {
+                        let j = o + l;
+                        *rho = self
+                            .scene
+                            .base_colour(g.tri[j], [g.b[0][j], g.b[1][j], g.b[2][j]]);
+                    }
+                    each3!(|a| s.gather(|l| rho[l][a]))
+                } else if same {
+                    let rho = materials[first.material as usize].colour;
+                    each3!(|a| s.splat(rho[a]))
+                } else {
+                    let mut rho = [Vec3::ZERO; 8];
+                    for (l, rho) in rho[..w].iter_mut().enumerate() {
+                        *rho = materials[tri(l).material as usize].colour;
+                    }
+                    each3!(|a| s.gather(|l| rho[l][a]))
+                };
+                let r = &mut pts.rho[bi];
+                each3!(|a| s.store_at(&mut r[a], ai, rho[a]));
+            }
         }
         let shadows = self.tile_shadows(s);
         self.add_lights(s, pts, m, SMOOTH, shadows, &mut scratch.shadows, n);
@@ -400,56 +430,28 @@ impl Tracer<'_> {
             _ => 0.0,
         };
         debug_assert!(m <= k);
-        // Whether a triangle's colour changes across it (vertex colours, textures): then each
-        // pixel's is looked up, even where a block's pixels share a triangle.
-        let varies = self.scene.colour_varies();
-        let materials = self.scene.materials();
+        let indirect = s.splat(indirect);
         for c in 0..chunks {
             let o = c * w;
             let count = (m - o).min(w);
-            let sum = &pts.sum[o / 8];
-            let sum = each3!(|a| s.load_at(&sum[a], o % 8));
-            let colour = match self.settings.mode {
-                Mode::Colour => {
-                    // Each pixel's base colour: its material's where colours do not vary
-                    // across triangles (one lookup where the block's pixels share a triangle),
-                    // else looked up at the pixel.
-                    let tri = |l: usize| &tris[tri_of[o + l] as usize];
-                    let rho = if varies {
-                        let mut rho = [Vec3::ZERO; 8];
-                        for (l, rho) in rho[..w].iter_mut().enumerate() {
-                            let j = o + l;
-                            *rho = self
-                                .scene
-                                .base_colour(g.tri[j], [g.b[0][j], g.b[1][j], g.b[2][j]]);
-                        }
-                        each3!(|a| s.gather(|l| rho[l][a]))
-                    } else if same_bits >> c & 1 == 1 {
-                        let rho = materials[tri(0).material as usize].colour;
-                        each3!(|a| s.splat(rho[a]))
-                    } else {
-                        let mut rho = [Vec3::ZERO; 8];
-                        for (l, rho) in rho[..w].iter_mut().enumerate() {
-                            *rho = materials[tri(l).material as usize].colour;
-                        }
-                        each3!(|a| s.gather(|l| rho[l][a]))
-                    };
-                    super::diffuse(s, rho, sum, [s.splat(indirect); 3])
+            let (bi, ai) = (o / 8, o % 8);
+            let sum = &pts.sum[bi];
+            let sum = each3!(|a| s.load_at(&sum[a], ai));
+            let colour = match colour {
+                true => {
+                    let rho = &pts.rho[bi];
+                    let rho = each3!(|a| s.load_at(&rho[a], ai));
+                    super::diffuse(s, rho, sum, [indirect; 3])
                 }
-                _ => sum,
+                false => sum,
             };
             let mut rgb = [[0f32; 8]; 3];
             each3!(|a| s.store(&mut rgb[a], colour[a]));
             let colour = |l: usize| Vec3::new(rgb[0][l], rgb[1][l], rgb[2][l]);
-            if g.idx[o + count - 1] as usize == o + count - 1 {
-                // These pixels in place (indices only grow): written in a row (eight of them
-                // the common case, unrolled).
-                if let Ok(row) = <&mut [Vec3; 8]>::try_from(&mut out[o..o + count]) {
-                    *row = std::array::from_fn(colour);
-                } else {
-                    for (l, out) in out[o..o + count].iter_mut().enumerate() {
-                        *out = colour(l);
-                    }
+            if count == 8 && g.idx[o + 7] as usize == o + 7 {
+                // Eight pixels in place (indices only grow): written in a row.
+                for (l, out) in out[o..o + 8].iter_mut().enumerate() {
+                    *out = colour(l);
                 }
             } else {
                 for l in 0..count {
