@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 use super::lane::{Lanes, Scalar, each3};
 use super::surface::{Surface, dot, offset_origin};
 use crate::geometry::Ray;
-use crate::light::{AreaLights, MAX_CANDIDATES};
+use crate::light::{AreaLights, LightPoint, MAX_CANDIDATES};
 use crate::scene::{DirectionalLight, PointLight, SpotLight};
 
 /// The kinds of light a frame ran besides point lights and emitting triangles (for `render
@@ -82,6 +82,12 @@ pub(crate) fn area_light(
 ) -> Option<AreaIncident> {
     let p = Vec3::from_array(at.p);
     let m = candidates.clamp(1, MAX_CANDIDATES);
+    if m == 1 {
+        // One candidate: kept whatever it brings, at its own density.
+        let lp = lights.sample(u)?;
+        let (wi, pdf) = seen_from(&lp, p)?;
+        return Some(incident(at, &lp, wi, pdf, pdf));
+    }
     // Each candidate: the point, its direction, density, target and weight.
     let mut drawn = [None; MAX_CANDIDATES];
     let mut total = 0.0;
@@ -91,26 +97,9 @@ pub(crate) fn area_light(
         else {
             continue;
         };
-        let d = lp.position - p;
-        // Only the light's front face emits; edge-on or on the point, it sends nothing.
-        let cos_d = -d.dot(lp.front);
-        if !(cos_d > 0.0) {
+        let Some((wi, pdf)) = seen_from(&lp, p) else {
             continue;
-        }
-        // `area_to_solid_angle`'s `pdf_area·r²/cos θ`, with cos θ = cos_d/r.
-        let r2 = d.length_squared();
-        let r = r2.sqrt();
-        let pdf = lp.pdf_area * r2 * r / cos_d;
-        if !(pdf.is_finite() && pdf > 0.0) {
-            continue;
-        }
-        let wi = d / r;
-        if m == 1 {
-            // One candidate: kept whatever it brings, at its own density.
-            *c = Some((lp, wi, pdf, pdf, 1.0));
-            total = 1.0;
-            break;
-        }
+        };
         let t = target(wi, lp.emission);
         let w = t / pdf;
         if !(t > 0.0 && w.is_finite()) {
@@ -133,22 +122,44 @@ pub(crate) fn area_light(
         }
     }
     let (lp, wi, candidate_pdf, t, _) = kept?;
-    let pdf = if m == 1 {
-        candidate_pdf
-    } else {
-        t * m as f32 / total
-    };
-    if !(pdf.is_finite() && pdf > 0.0) {
+    let pdf = t * m as f32 / total;
+    (pdf.is_finite() && pdf > 0.0).then(|| incident(at, &lp, wi, pdf, candidate_pdf))
+}
+
+/// The unit direction from `p` toward the light point `lp`, and the density per solid angle
+/// of having drawn it; `None` where the light's back faces `p` or is edge-on (only its front
+/// face emits) or sits on it.
+#[inline]
+fn seen_from(lp: &LightPoint, p: Vec3) -> Option<(Vec3, f32)> {
+    let d = lp.position - p;
+    let cos_d = -d.dot(lp.front);
+    if !(cos_d > 0.0) {
         return None;
     }
+    // `area_to_solid_angle`'s `pdf_area·r²/cos θ`, with cos θ = cos_d/r.
+    let r2 = d.length_squared();
+    let r = r2.sqrt();
+    let pdf = lp.pdf_area * r2 * r / cos_d;
+    (pdf.is_finite() && pdf > 0.0).then(|| (d / r, pdf))
+}
+
+/// The light point `lp` as seen from `at` along `wi`, with its shadow ray.
+#[inline]
+fn incident(
+    at: &Surface<f32>,
+    lp: &LightPoint,
+    wi: Vec3,
+    pdf: f32,
+    candidate_pdf: f32,
+) -> AreaIncident {
     let origin = Vec3::from_array(offset_origin(Scalar, at, wi.to_array()));
-    Some(AreaIncident {
+    AreaIncident {
         wi,
         pdf,
         candidate_pdf,
         emission: lp.emission,
         shadow: Ray::new(origin, lp.position - origin),
-    })
+    }
 }
 
 /// How far each candidate's second number is shifted from the previous one's (the golden
