@@ -91,6 +91,14 @@ impl SurfaceBsdf {
         )
     }
 
+    /// Whether it scatters nothing: diffuse only, of reflectance zero (a pure emitter's).
+    /// Its `f` is zero everywhere and its samples carry zero.
+    pub fn is_black(&self) -> bool {
+        self.lobes()
+            .iter()
+            .all(|(_, b)| matches!(b, Bsdf::Lambertian(l) if l.reflectance == Vec3::ZERO))
+    }
+
     /// `Σ wᵢ fᵢ(wo, wi)`, transmitted light tinted.
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let f: Vec3 = self.lobes().iter().map(|(w, b)| b.f(wo, wi) * *w).sum();

@@ -291,8 +291,14 @@ impl Tracer<'_> {
             // Glass has air on the front side (local z > 0).
             let front = tri.front();
             let toward = -ray.dir.normalize();
-            let (frame, wo) = self.frame(&at, front, toward);
             let bsdf = SurfaceBsdf::new(material, scene.base_colour(hit.triangle, hit.b));
+            if bsdf.is_black() {
+                // Nothing arrives through it: every light would add zero and the path's
+                // weight would become zero (the plates' emitting balls, which bounce rays
+                // from the plates find often).
+                break;
+            }
+            let (frame, wo) = self.frame(&at, front, toward);
             // Only the numbers this vertex uses are drawn: each costs a Sobol dimension (a
             // hash per coordinate), and a diffuse or metal vertex has no lobe to choose.
             let (draws_choice, draws_direction) = bsdf.draws();
