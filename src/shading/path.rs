@@ -180,6 +180,11 @@ struct Came {
 /// vertex, diffuse too, bought nothing on area and cost on glass.
 const GLOSSY_FIRST_LIGHT_SAMPLES: u32 = 3;
 
+/// How far each light sample's second number is shifted from the previous one's at a vertex
+/// that draws several (the golden ratio's fraction, as the candidates' in
+/// `super::light::area_light`).
+const SAMPLE_STEP_Y: f32 = 0.618_034;
+
 impl Tracer<'_> {
     /// Whether this frame shades by [`Tracer::path`]: a colour frame with path-traced light
     /// of a scene that calls for the physically based path.
@@ -365,10 +370,25 @@ impl Tracer<'_> {
                 if mis != Estimator::Bsdf
                     && let Some(lights) = scene.area_lights()
                 {
-                    for _ in 0..light_samples {
-                        let u = Vec2::from(rng.next_2d());
-                        let candidates = lights.candidates();
-                        let u_pick = if candidates > 1 { rng.next_1d() } else { 0.0 };
+                    // One 2D number and one pick for the vertex's samples: sample i takes
+                    // them shifted by (i/(k·candidates), i·φ) and i/k (each still uniform),
+                    // so that its candidates fall between the others' (a grid of
+                    // k·candidates in the first number) and no Sobol dimension is drawn
+                    // for it.
+                    let candidates = lights.candidates();
+                    let u0 = Vec2::from(rng.next_2d());
+                    let pick0 = if candidates > 1 { rng.next_1d() } else { 0.0 };
+                    for i in 0..light_samples {
+                        let (u, u_pick) = if i == 0 {
+                            (u0, pick0)
+                        } else {
+                            let i = i as f32;
+                            let dx = i / (k * candidates as f32);
+                            (
+                                Vec2::new((u0.x + dx).fract(), (u0.y + i * SAMPLE_STEP_Y).fract()),
+                                (pick0 + i / k).fract(),
+                            )
+                        };
                         // What a candidate would bring, unshadowed: the BSDF's value times the
                         // emission and the cosine.
                         let target = |wi: Vec3, emission: Vec3| {
