@@ -1,6 +1,6 @@
-//! Eight boxes at a time: the children of one wide BVH node, slab-tested eight lanes at a
-//! time (AVX2), four (SSE2) or one: [`Aabb::enter`]'s operations, so every path agrees with it
-//! bit for bit (the unit test below).
+//! Eight boxes at a time: the children of one wide BVH node, or eight of the flat list's
+//! objects, slab-tested eight lanes at a time (AVX2), four (SSE2) or one: [`Aabb::enter`]'s
+//! operations, so every path agrees with it bit for bit (the unit test below).
 
 use crate::geometry::{Aabb, enter_boxes};
 use crate::simd::Lanes;

@@ -15,7 +15,6 @@
 //! Both test triangles four or eight at a time ([`tri4`]) on the widest SIMD path the CPU has
 //! ([`Isa::detect`]); every path gives the same hits, bit for bit.
 
-mod box4;
 mod box8;
 mod bvh;
 mod flat;
