@@ -1,8 +1,10 @@
 //! Path tracing of physically based scenes: the materials of [`crate::material`] (asked only
 //! through [`SurfaceBsdf`]), emitting triangles as area lights, and the point lights. At each
 //! vertex, next-event estimation (each point light, exactly, as [`super::light::point_light`]
-//! gives it; one area light picked by power, one point on it, one shadow ray, twice at a
-//! glossy first vertex: `GLOSSY_FIRST_LIGHT_SAMPLES`) and one BSDF sample to go on with;
+//! gives it; one point on the area lights, drawn by power and area, and where emitters face
+//! different ways the better of two such candidates by what each would bring
+//! ([`super::light::area_light`]), one shadow ray; three at a glossy first vertex:
+//! `GLOSSY_FIRST_LIGHT_SAMPLES`) and one BSDF sample to go on with;
 //! where the frame's [`Estimator`] says so, the two are combined by multiple importance
 //! sampling with the power heuristic (Veach 1997), so that light reaching a vertex is counted
 //! once.
