@@ -118,6 +118,22 @@ impl<L: Lanes> Sheared<L> {
         let zero = L::splat(0.0);
         let any_neg = L::or(L::or(e[0].lt(zero), e[1].lt(zero)), e[2].lt(zero));
         let any_pos = L::or(L::or(e[0].gt(zero), e[1].gt(zero)), e[2].gt(zero));
+        // Edge functions of both signs: the ray passes beside the triangle, as it does for
+        // most lanes a traversal tests; when every lane does (or is to be redone), the rest
+        // of the test is skipped.
+        let beside = L::and(any_neg, any_pos);
+        let redo_bits = L::bits(redo);
+        let full = (1u32 << L::N).wrapping_sub(1);
+        let none = Found {
+            mask: 0,
+            redo: redo_bits,
+            accepted: L::none(),
+            t: zero,
+            b: [zero; 3],
+        };
+        if !L::bits(beside) & !redo_bits & full == 0 {
+            return none;
+        }
         let det = e[0].add(e[1]).add(e[2]);
         let sz = self.shear[2];
         let zs = [sz.mul(self.z[0]), sz.mul(self.z[1]), sz.mul(self.z[2])];
@@ -126,25 +142,14 @@ impl<L: Lanes> Sheared<L> {
         // Rejected in the scalar order: mixed signs, a zero or NaN det, `t·det` outside
         // (0, t_max·det] on det's side.
         let reject = L::or(
-            L::or(
-                L::and(any_neg, any_pos),
-                L::or(det.eq(zero), det.unord(det)),
-            ),
+            L::or(beside, L::or(det.eq(zero), det.unord(det))),
             L::or(
                 L::and(det.lt(zero), L::or(t_scaled.ge(zero), t_scaled.lt(bound))),
                 L::and(det.gt(zero), L::or(t_scaled.le(zero), t_scaled.gt(bound))),
             ),
         );
-        let redo_bits = L::bits(redo);
-        let full = (1u32 << L::N).wrapping_sub(1);
         if !L::bits(reject) & !redo_bits & full == 0 {
-            return Found {
-                mask: 0,
-                redo: redo_bits,
-                accepted: L::none(),
-                t: zero,
-                b: [zero; 3],
-            };
+            return none;
         }
         let inv_det = L::splat(1.0).div(det);
         let t = t_scaled.mul(inv_det);
