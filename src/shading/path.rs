@@ -2,7 +2,7 @@
 //! through [`SurfaceBsdf`]), emitting triangles as area lights, and the point lights. At each
 //! vertex, next-event estimation (each point light, exactly, as [`super::light::point_light`]
 //! gives it; one point on the area lights, drawn by power and area, and where emitters face
-//! different ways the better of two such candidates by what each would bring
+//! different ways one of two such candidates, picked in proportion to what each would bring
 //! ([`super::light::area_light`]), one shadow ray; three at a glossy first vertex:
 //! `GLOSSY_FIRST_LIGHT_SAMPLES`) and one BSDF sample to go on with;
 //! where the frame's [`Estimator`] says so, the two are combined by multiple importance
@@ -174,7 +174,7 @@ struct Came {
 /// are most of what the camera sees, and a sample costs one shadow ray where a path costs
 /// several: on the plates (160x100, 256 spp, values clamped, against Mitsuba 3's 16384-spp
 /// frame) two rather than one took the MSE 1.18e-4 -> 0.90e-4 for ~5 % more CPU time (time
-/// x MSE -21 %). Since a sample keeps the better of two candidates there
+/// x MSE -21 %). Since a sample resamples one of two candidates there
 /// ([`crate::light::AreaLights::candidates`]), three rather than two (1024 spp): RMSE
 /// 0.00433 -> 0.00404 for 9 % more instructions (time x MSE -5 %), four 0.00385 for 18 %
 /// more (-7 % by instructions, no better by CPU time); glass within noise (RMSE 0.00834 ->
