@@ -223,29 +223,10 @@ impl Tracer<'_> {
         self.shade_lanes(s, rays, best, out, n, scratch)
     }
 
-    /// The kernel (see the module's doc), inlined into each entry: compiled once for scenes
-    /// with shading normals and once for scenes without, which then pay nothing for them (the
-    /// seed frame's instructions −2 %, callgrind).
-    #[inline(always)]
-    fn shade_lanes<S: Lanes>(
-        &self,
-        s: S,
-        rays: &RayTile,
-        best: &[Best8; N / 8],
-        out: &mut [Vec3],
-        n: &mut RayCounts,
-        scratch: &mut super::TileScratch,
-    ) {
-        match self.smooth {
-            true => self.shade_lanes_as::<S, true>(s, rays, best, out, n, scratch),
-            false => self.shade_lanes_as::<S, false>(s, rays, best, out, n, scratch),
-        }
-    }
-
-    /// [`Tracer::shade_lanes`] where `SMOOTH` is whether the scene has shading normals.
+    /// The kernel (see the module's doc), inlined into each entry.
     #[inline(always)]
     #[allow(clippy::needless_range_loop)] // lanes, blocks and axes, in step across arrays
-    fn shade_lanes_as<S: Lanes, const SMOOTH: bool>(
+    fn shade_lanes<S: Lanes>(
         &self,
         s: S,
         rays: &RayTile,
@@ -379,7 +360,7 @@ impl Tracer<'_> {
             let b = each3!(|a| s.load(block(&g.b[a], o)));
             let mut at = surface(s, v, normal, b, dir);
             let (bi, ai) = (o / 8, o % 8);
-            if SMOOTH {
+            if self.smooth {
                 // Each pixel's interpolated vertex normal (the triangle's where it has none).
                 let ns: [Vec3; 8] = std::array::from_fn(|l| {
                     let j = o + l.min(w - 1);
@@ -424,7 +405,7 @@ impl Tracer<'_> {
             }
         }
         let shadows = self.tile_shadows(s);
-        self.add_lights(s, pts, m, SMOOTH, shadows, &mut scratch.shadows, n);
+        self.add_lights(s, pts, m, shadows, &mut scratch.shadows, n);
         let indirect = match self.settings.effects.indirect {
             Indirect::Constant(k) => k,
             _ => 0.0,
@@ -480,7 +461,6 @@ impl Tracer<'_> {
             Scalar,
             &mut pts,
             1,
-            self.smooth,
             Shadows::Scene,
             &mut ShadowScratch::default(),
             n,
@@ -488,18 +468,16 @@ impl Tracer<'_> {
         Points::at(&pts.sum, 0)
     }
 
-    /// The sums over the lights at the first `m` points of `pts` (their surfaces computed,
-    /// with shading normals if `smooth`): light by light, each point's term where the light
+    /// The sums over the lights at the first `m` points of `pts` (their surfaces computed):
+    /// light by light, each point's term where the light
     /// reaches it and no shadow ray is blocked (the tile's shadow rays toward a light traced
     /// together, as `shadows` says).
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     fn add_lights<S: Lanes, const B: usize>(
         &self,
         s: S,
         pts: &mut Points<B>,
         m: usize,
-        smooth: bool,
         shadows: Shadows,
         scratch: &mut ShadowScratch,
         n: &mut RayCounts,
@@ -515,7 +493,7 @@ impl Tracer<'_> {
                 continue;
             }
             let light = Delta::Point(light);
-            self.add_light(s, pts, m, smooth, light, shadows, li, scratch, n);
+            self.add_light(s, pts, m, light, shadows, li, scratch, n);
         }
         // The other delta lights: no shadow cull of their own, so their rays go through the
         // scene's structure.
@@ -524,14 +502,14 @@ impl Tracer<'_> {
                 continue;
             }
             let light = Delta::Directional(light);
-            self.add_light(s, pts, m, smooth, light, Shadows::Scene, 0, scratch, n);
+            self.add_light(s, pts, m, light, Shadows::Scene, 0, scratch, n);
         }
         for light in self.scene.spot_lights() {
             if light.power == Vec3::ZERO {
                 continue;
             }
             let light = Delta::Spot(light);
-            self.add_light(s, pts, m, smooth, light, Shadows::Scene, 0, scratch, n);
+            self.add_light(s, pts, m, light, Shadows::Scene, 0, scratch, n);
         }
         // Frames that trace no random ray take the environment unshadowed, as the seed's
         // constant N (path-traced ones find it where their rays leave the scene).
@@ -558,7 +536,6 @@ impl Tracer<'_> {
         s: S,
         pts: &mut Points<B>,
         m: usize,
-        smooth: bool,
         light: Delta,
         shadows: Shadows,
         li: usize,
@@ -572,10 +549,10 @@ impl Tracer<'_> {
         let (mut lit, mut traced) = (0u64, 0u64);
         for c in 0..chunks {
             let o = c * w;
-            let at = pts.surface(s, o, smooth);
+            let at = pts.surface(s, o, self.smooth);
             // (A match, not a closure: a closure would not be compiled with the kernel's
             // target features, and the lane functions would not inline into it.)
-            let shadows_on = self.settings.effects.shadows;
+            let (shadows_on, smooth) = (self.settings.effects.shadows, self.smooth);
             let inc = match light {
                 Delta::Point(l) => point_light(s, l, self.min_r2, &at, shadows_on, smooth),
                 Delta::Directional(l) => {
