@@ -92,7 +92,7 @@ pub(crate) fn area_light(
     let mut drawn = [None; MAX_CANDIDATES];
     let mut total = 0.0;
     for (j, c) in drawn[..m].iter_mut().enumerate() {
-        let shift = Vec2::new(j as f32 / m as f32, j as f32 * CANDIDATE_STEP_Y);
+        let shift = Vec2::new(j as f32 / m as f32, j as f32 * STEP_Y);
         let Some(lp) = lights.sample(Vec2::new((u.x + shift.x).fract(), (u.y + shift.y).fract()))
         else {
             continue;
@@ -163,8 +163,9 @@ fn incident(
 }
 
 /// How far each candidate's second number is shifted from the previous one's (the golden
-/// ratio's fraction: the shifts stay apart for any number of candidates).
-const CANDIDATE_STEP_Y: f32 = 0.618_034;
+/// ratio's fraction: the shifts stay apart for any number of candidates); the path tracer
+/// shifts a vertex's several light samples by it too.
+pub(super) const STEP_Y: f32 = 0.618_034;
 
 /// One light's contribution at a [`Surface`]'s points, one per lane.
 pub(crate) struct Incident<F> {

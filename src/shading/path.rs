@@ -21,7 +21,7 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 
 use super::lane::Scalar;
-use super::light::{AreaIncident, area_light, directional_light, point_light, spot_light};
+use super::light::{AreaIncident, STEP_Y, area_light, directional_light, point_light, spot_light};
 use super::surface::{Surface, offset_origin};
 use super::{MIN_SURVIVAL, Mode, ROULETTE_START, RayCounts, SHADOW_EPSILON, Tracer, surface_of};
 use crate::accel::Hit;
@@ -181,11 +181,6 @@ struct Came {
 /// 0.00835, +0.7 % instructions), area untouched (no glossy first hit). Two at every first
 /// vertex, diffuse too, bought nothing on area and cost on glass.
 const GLOSSY_FIRST_LIGHT_SAMPLES: u32 = 3;
-
-/// How far each light sample's second number is shifted from the previous one's at a vertex
-/// that draws several (the golden ratio's fraction, as the candidates' in
-/// `super::light::area_light`).
-const SAMPLE_STEP_Y: f32 = 0.618_034;
 
 impl Tracer<'_> {
     /// Whether this frame shades by [`Tracer::path`]: a colour frame with path-traced light
@@ -387,7 +382,7 @@ impl Tracer<'_> {
                             let i = i as f32;
                             let dx = i / (k * candidates as f32);
                             (
-                                Vec2::new((u0.x + dx).fract(), (u0.y + i * SAMPLE_STEP_Y).fract()),
+                                Vec2::new((u0.x + dx).fract(), (u0.y + i * STEP_Y).fract()),
                                 (pick0 + i / k).fract(),
                             )
                         };
