@@ -123,7 +123,8 @@ impl<'a> Tracer<'a> {
             return self.background;
         };
         let c = if self.physical() {
-            self.path(ray, &hit, rng, n).sum()
+            self.path(ray, &hit, &surface_of(self.scene, &hit, ray), rng, n)
+                .sum()
         } else {
             self.shade(ray, &hit, 0, 0, rng, n)
         };
@@ -199,7 +200,7 @@ impl<'a> Tracer<'a> {
         let at = surface_of(self.scene, hit, ray);
         let (p, normal) = (Vec3::from_array(at.p), Vec3::from_array(at.normal));
         if self.physical() {
-            let c = self.path(ray, hit, rng, n);
+            let c = self.path(ray, hit, &at, rng, n);
             let guide = Some(GuideHit {
                 position: p,
                 normal,

@@ -238,11 +238,13 @@ impl Tracer<'_> {
         bsdf.f(wo, wl)
     }
 
-    /// One path from the primary `hit` of `ray`: the colour it brings back, in two parts.
+    /// One path from the primary `hit` of `ray` (`first`: its surface, as
+    /// [`surface_of`] gives it): the colour it brings back, in two parts.
     pub(super) fn path(
         &self,
         ray: &Ray,
         hit: &Hit,
+        first: &Surface<f32>,
         rng: &mut impl SampleSource,
         n: &mut RayCounts,
     ) -> PathColour {
@@ -259,7 +261,7 @@ impl Tracer<'_> {
         // vertex): what it brings from then on is sharp.
         let mut focused = false;
         let mut beta = Vec3::ONE;
-        let (mut ray, mut hit) = (*ray, *hit);
+        let (mut ray, mut hit, mut at) = (*ray, *hit, *first);
         let mut came = Came {
             from: ray.origin,
             pdf: None,
@@ -272,7 +274,6 @@ impl Tracer<'_> {
             let exact = if vertex == 0 { 0 } else { soft };
             let tri = &scene.triangle(hit.triangle);
             let material = &scene.materials()[tri.material as usize];
-            let at = surface_of(scene, &hit, &ray);
             let p = Vec3::from_array(at.p);
             let e = Tracer::emitted(tri, material, &ray);
             if e != Vec3::ZERO {
@@ -477,7 +478,10 @@ impl Tracer<'_> {
                 light_samples: k,
             };
             match scene.intersect(&ray, f32::INFINITY) {
-                Some(h) => hit = h,
+                Some(h) => {
+                    hit = h;
+                    at = surface_of(scene, &hit, &ray);
+                }
                 None => {
                     // The environment, found by BSDF sampling alone (counted whole): under a
                     // constant sky the BSDF's own sampling draws `f·cos` as well as any light
