@@ -231,17 +231,6 @@ impl Kernel for Tile<'_> {
     }
 }
 
-/// `a·d` in the order `a[0]·d[0] + a[1]·d[1] + a[2]·d[2]`, lane by lane (a function, not a
-/// closure, so that it is sure to inline into the path's code).
-#[inline(always)]
-fn dot<L: Lanes>(a: [f32; 3], d: [L; 3]) -> L {
-    let [x, y, z] = a;
-    L::splat(x)
-        .mul(d[0])
-        .add(L::splat(y).mul(d[1]))
-        .add(L::splat(z).mul(d[2]))
-}
-
 /// [`RayGen::tile`], `L::N` rays at a time: [`RayGen::ray`]'s operations, then the axes
 /// ([`crate::geometry::Ray::axes`]) and shear of each lane, kept when every lane shares
 /// them.
@@ -256,27 +245,44 @@ fn tile_lanes<L: Lanes>(
     let splat = L::splat;
     let m = &g.rotation;
     let rows_of_m = [0, 1, 2].map(|i| m.row(i).to_array());
+    // What every row shares, worked out once (written out: a closure would not inline the
+    // path's lane operations): the matrix's columns for x and y, its z column times the
+    // focal length (the product `Mat3 * Vec3` takes lane by lane, so the same bits), and the
+    // image's centre.
+    let [m0, m1, m2] = rows_of_m;
+    let m_x = [splat(m0[0]), splat(m1[0]), splat(m2[0])];
+    let m_y = [splat(m0[1]), splat(m1[1]), splat(m2[1])];
+    let focal = splat(g.focal);
+    let m_z = [
+        splat(m0[2]).mul(focal),
+        splat(m1[2]).mul(focal),
+        splat(m2[2]).mul(focal),
+    ];
+    let (half_w, half_h) = (splat(g.half_w), g.half_h);
     let zero = splat(0.0);
     let full = (1u32 << L::N).wrapping_sub(1);
-    // The common axes, `None` once a lane differs (`mixed`).
-    let mut common: Option<[usize; 3]> = None;
+    // The main axis and its sign shared by every lane so far (`None` until the first row),
+    // `mixed` once a lane differs.
+    let mut common: Option<(usize, bool)> = None;
     let mut mixed = false;
     let (mut lo, mut hi) = ([splat(f32::INFINITY); 3], [splat(f32::NEG_INFINITY); 3]);
     for r in 0..rows {
         for at in (r * cols..r * cols + 8).step_by(L::N) {
-            let (px, py) = match positions {
-                Positions::Centres(xs, y0) => {
-                    (L::load(&xs[at - r * cols..]), splat((y0 + r) as f32 + 0.5))
-                }
-                Positions::At(px, py) => (L::load(&px[at..]), L::load(&py[at..])),
+            let (dx, dy) = match positions {
+                Positions::Centres(xs, y0) => (
+                    L::load(&xs[at - r * cols..]).sub(half_w),
+                    splat((y0 + r) as f32 + 0.5 - half_h),
+                ),
+                Positions::At(px, py) => (
+                    L::load(&px[at..]).sub(half_w),
+                    L::load(&py[at..]).sub(splat(half_h)),
+                ),
             };
-            let (dx, dy) = (px.sub(splat(g.half_w)), py.sub(splat(g.half_h)));
-            let dz = splat(g.focal);
             // `Mat3 * Vec3`: x_axis·d.x + y_axis·d.y + z_axis·d.z, in that order.
             let d = [
-                dot(rows_of_m[0], [dx, dy, dz]),
-                dot(rows_of_m[1], [dx, dy, dz]),
-                dot(rows_of_m[2], [dx, dy, dz]),
+                m_x[0].mul(dx).add(m_y[0].mul(dy)).add(m_z[0]),
+                m_x[1].mul(dx).add(m_y[1].mul(dy)).add(m_z[1]),
+                m_x[2].mul(dx).add(m_y[2].mul(dy)).add(m_z[2]),
             ];
             // `normalize`: times 1 / sqrt(x·x + y·y + z·z).
             let len2 = d[0].mul(d[0]).add(d[1].mul(d[1])).add(d[2].mul(d[2]));
@@ -306,12 +312,11 @@ fn tile_lanes<L: Lanes>(
                     continue;
                 }
             };
-            let axes = axes_of(kz, negative);
-            if *common.get_or_insert(axes) != axes {
+            if *common.get_or_insert((kz, negative)) != (kz, negative) {
                 mixed = true;
                 continue;
             }
-            let shear = shear_of(d, axes, splat(1.0).div(d[kz]));
+            let shear = shear_of(d, axes_of(kz, negative), splat(1.0).div(d[kz]));
             for (k, s) in shear.into_iter().enumerate() {
                 s.store(&mut out.shear[k][at..]);
                 lo[k] = lo[k].min(s);
@@ -321,7 +326,9 @@ fn tile_lanes<L: Lanes>(
     }
     out.origin = g.origin;
     out.len = rows * cols;
-    out.axes = common.filter(|_| !mixed);
+    out.axes = common
+        .filter(|_| !mixed)
+        .map(|(kz, negative)| axes_of(kz, negative));
     let fold = |v: L, f: fn(f32, f32) -> f32| {
         let mut a = [0.0; 16];
         v.store(&mut a);

@@ -293,9 +293,8 @@ impl BestTile {
         for (row, b) in out.b.iter_mut().zip(&self.b) {
             row.copy_from_slice(&b[at.clone()]);
         }
-        for (id, bits) in out.id.iter_mut().zip(&self.id[at]) {
-            *id = bits.to_bits();
-        }
+        let ids: &[f32; 8] = self.id[at].try_into().expect("eight lanes");
+        out.id = ids.map(f32::to_bits);
     }
 }
 
