@@ -315,6 +315,11 @@ impl Tracer<'_> {
                 1
             };
             let k = light_samples as f32;
+            // The sampler's first two pairs form one 4D point: at a first vertex that draws
+            // both, this direction and this vertex's light sample. Pairing the direction with
+            // the next vertex's light sample instead (the one-bounce light depends on both)
+            // took the area box's MSE down by only 1.3 % (160x100, 256 spp): not worth drawing
+            // out of order.
             let u_bsdf = if draws_direction {
                 Vec2::from(rng.next_2d())
             } else {
@@ -432,6 +437,11 @@ impl Tracer<'_> {
                 break;
             };
             let mut weight = s.weight();
+            // Where roulette starts, measured for this path too (area, 160x100, 256 spp,
+            // values clamped, against Mitsuba 3's 16384-spp frame, its noise taken out; rays a
+            // sample as the cost): from vertex 1, 2, 4, 5, 7 or never, MSE +61, +18, -7, -12,
+            // -14, -14 % for rays -19, -9, +8, +14, +24, +47 %: rays x MSE +31, +8, 0, +1, +8,
+            // +26 %. The seed's 3 is at the optimum.
             if vertex >= ROULETTE_START {
                 // The survival chance follows what the surface keeps of the light: a
                 // refraction's 1/η'² is radiance changing units across the interface (undone
