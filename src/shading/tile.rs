@@ -30,8 +30,7 @@ fn block(a: &[f32], o: usize) -> &Block {
     a[o..o + 8].try_into().expect("eight lanes")
 }
 
-/// `0, 1, 2, …`: the indices of a tile's pixels in place, and pixel `j` on the `j`-th of a
-/// tile's triangles rebuilt (see `shade_lanes`).
+/// `0, 1, 2, …`: the indices of a tile's pixels in place.
 static PIXEL_ORDER: [u32; N] = {
     let mut order = [0; N];
     let mut j = 0;
@@ -42,22 +41,21 @@ static PIXEL_ORDER: [u32; N] = {
     order
 };
 
-/// The pixels of a tile gathered for the kernel, packed in order.
+/// The pixels of a tile gathered for the kernel, packed in order, from the first that is not
+/// in place (see `shade_lanes`).
 #[derive(Clone, Debug)]
 pub(crate) struct Gathered {
-    /// Each pixel's index in the tile, and its triangle.
+    /// Each pixel's index in the tile.
     idx: [u32; N],
-    tri: [u32; N],
-    /// The hit's barycentrics (eight more, so that any pixel starts a [`Block`]).
-    b: [[f32; N + 8]; 3],
+    /// Each pixel's hit: pixel `j` in lane `j % 8` of block `j / 8`.
+    hits: [Best8; N / 8],
 }
 
 impl Default for Gathered {
     fn default() -> Self {
         Gathered {
             idx: [0; N],
-            tri: [0; N],
-            b: [[0.0; N + 8]; 3],
+            hits: [Best8::NONE; N / 8],
         }
     }
 }
@@ -239,13 +237,16 @@ impl Tracer<'_> {
         let (g, pts) = (&mut *scratch.gathered, &mut *scratch.points);
         let k = rays.len();
         debug_assert!(k <= N);
-        // The pixels shaded here, packed in order; the others one at a time.
+        // The pixels shaded here, packed in order; the others one at a time. The first
+        // `placed` are the tile's first packets, all shaded here: read where they are, in
+        // `best`; the rest are gathered into `g`.
         let mut m = 0;
+        let mut placed = 0;
         let mut others = 0u64;
         // `in_lanes` of the last triangle asked (neighbours mostly hit the same one).
         let mut last = (u32::MAX, false);
         for c in 0..k.div_ceil(8) {
-            let (ids, bary) = (best[c].ids(), best[c].barycentrics());
+            let ids = best[c].ids();
             let lanes = (k - 8 * c).min(8);
             let own = if lanes == 8 && *ids == [ids[0]; 8] && ids[0] != u32::MAX {
                 // Eight hits on one triangle.
@@ -265,12 +266,14 @@ impl Tracer<'_> {
                 }
                 own
             };
-            // Eight pixels all shaded here (most packets): copied as they are.
-            if own == 0xff {
-                g.idx[m..m + 8].copy_from_slice(&PIXEL_ORDER[8 * c..8 * c + 8]);
-                g.tri[m..m + 8].copy_from_slice(ids);
-                for a in 0..3 {
-                    g.b[a][m..m + 8].copy_from_slice(&bary[a]);
+            // Eight pixels all shaded here (most packets): left in place while every pixel
+            // before them is, else copied as they are.
+            if own == 0xff && m % 8 == 0 {
+                if m == 8 * c {
+                    placed = m + 8;
+                } else {
+                    g.idx[m..m + 8].copy_from_slice(&PIXEL_ORDER[8 * c..8 * c + 8]);
+                    g.hits[m / 8] = best[c];
                 }
                 m += 8;
                 continue;
@@ -285,10 +288,7 @@ impl Tracer<'_> {
                     // (`m < N`: the mask only tells the compiler so.)
                     let j = m & (N - 1);
                     g.idx[j] = i as u32;
-                    g.tri[j] = ids[l];
-                    for a in 0..3 {
-                        g.b[a][j] = bary[a][l];
-                    }
+                    g.hits[j / 8].set(j % 8, best[c].hit(l));
                     m += 1;
                 }
             }
@@ -305,28 +305,32 @@ impl Tracer<'_> {
         let dirs = rays.dir_lanes();
         let chunks = m.div_ceil(w);
         // Lanes past the last pixel repeat it (its triangle, index and barycentrics), so that
-        // every block reads whole lanes.
+        // every block reads whole lanes. (A last block in place is whole.)
         let end = chunks * w;
         let last = m - 1;
         for j in m..end {
-            g.tri[j] = g.tri[last];
             g.idx[j] = g.idx[last];
-            for a in 0..3 {
-                g.b[a][j] = g.b[a][last];
-            }
+            let hit = g.hits[last / 8].hit(last % 8);
+            g.hits[j / 8].set(j % 8, hit);
         }
-        // Pixel `j`'s triangle is `tris[tri_of[j]]`. A big model keeps no list of triangles
-        // (`Scene::triangle`): the tile's are rebuilt here, once each, in pixel order.
-        // (Scenes with a list are read in place: copying triangles out of it cost the seed's
-        // frame 8 % more instructions.)
+        // A big model keeps no list of triangles (`Scene::triangle`): the tile's are rebuilt
+        // here, once each, pixel `j`'s at `j`. (Scenes with a list are read in place: copying
+        // triangles out of it cost the seed's frame 8 % more instructions.)
         let rebuilt = &mut scratch.triangles;
-        let (tris, tri_of) = match self.scene.triangles() {
+        let (tris, by_pixel) = match self.scene.triangles() {
             [] => {
                 rebuilt.clear();
-                rebuilt.extend(g.tri[..end].iter().map(|&t| self.scene.triangle(t)));
-                (rebuilt.as_slice(), &PIXEL_ORDER)
+                rebuilt.extend((0..end).map(|j| {
+                    let hits = if j < placed {
+                        &best[j / 8]
+                    } else {
+                        &g.hits[j / 8]
+                    };
+                    self.scene.triangle(hits.ids()[j % 8])
+                }));
+                (rebuilt.as_slice(), true)
             }
-            list => (list, &g.tri),
+            list => (list, false),
         };
         // Colour frames look each pixel's base colour up here, where its triangle is at hand:
         // its material's where colours do not vary across triangles, else at the pixel
@@ -336,58 +340,60 @@ impl Tracer<'_> {
         let materials = self.scene.materials();
         for c in 0..chunks {
             let o = c * w;
-            let count = (m - o).min(w);
-            let first = &tris[tri_of[o] as usize];
+            // Pixel `o + l` is lane `at + l` of `hit` (`at` is 0 on eight lanes): a packet of
+            // `best` in place, else of `g`.
+            let (bi, at) = (o / 8, o % 8);
+            let hit = if o < placed { &best[bi] } else { &g.hits[bi] };
+            let (ids, bary) = (hit.ids(), hit.barycentrics());
+            // (Closures that copy what they use: none is left in memory for the others.)
+            let tri = move |l: usize| match by_pixel {
+                true => &tris[o + l],
+                false => &tris[ids[at + l] as usize],
+            };
+            let first = tri(0);
             // The pixels are all on one triangle (the common case): its values are splatted,
             // else gathered lane by lane.
-            let same = w == 1 || g.tri[o..o + 8] == [g.tri[o]; 8];
-            let tri = |l: usize| &tris[tri_of[o + l] as usize];
+            let same = w == 1 || *ids == [ids[0]; 8];
             let v = each3!(|j| each3!(|a| match same {
                 true => s.splat(first.v[j][a]),
-                false => s.gather(|l| tri(l).v[j][a]),
+                false => s.gather(move |l| tri(l).v[j][a]),
             }));
             let normal = each3!(|a| match same {
                 true => s.splat(first.normal[a]),
-                false => s.gather(|l| tri(l).normal[a]),
+                false => s.gather(move |l| tri(l).normal[a]),
             });
-            // The rays' directions: the tile's own lanes when these pixels are the tile's
-            // pixels `o..` (indices only grow, so the last one tells), else gathered.
-            let in_place = g.idx[o + count - 1] as usize == o + count - 1 && o + 8 <= N;
-            let dir = each3!(|a| match in_place {
-                true => s.load(block(&dirs[a], o)),
+            // The rays' directions: the tile's own lanes in place, else gathered.
+            let dir = each3!(|a| match o < placed {
+                true => s.load_at(block(&dirs[a], o - at), at),
                 false => s.gather(|l| dirs[a][g.idx[o + l] as usize]),
             });
-            let b = each3!(|a| s.load(block(&g.b[a], o)));
-            let mut at = surface(s, v, normal, b, dir);
-            let (bi, ai) = (o / 8, o % 8);
+            let b = each3!(|a| s.load_at(&bary[a], at));
+            let mut surf = surface(s, v, normal, b, dir);
             if self.smooth {
                 // Each pixel's interpolated vertex normal (the triangle's where it has none).
-                let ns: [Vec3; 8] = std::array::from_fn(|l| {
-                    let j = o + l.min(w - 1);
-                    let b = [g.b[0][j], g.b[1][j], g.b[2][j]];
-                    let t = g.tri[j];
+                let ns: [Vec3; 8] = std::array::from_fn(move |l| {
+                    let l = l.min(w - 1);
+                    let b = [bary[0][at + l], bary[1][at + l], bary[2][at + l]];
                     self.scene
-                        .shading_normal(t, b)
-                        .unwrap_or_else(|| tri(l.min(w - 1)).normal)
+                        .shading_normal(ids[at + l], b)
+                        .unwrap_or_else(|| tri(l).normal)
                 });
-                with_shading(s, &mut at, each3!(|a| s.gather(|l| ns[l][a])));
+                with_shading(s, &mut surf, each3!(|a| s.gather(|l| ns[l][a])));
                 let sh = &mut pts.shading[bi];
-                each3!(|a| s.store_at(&mut sh[a], ai, at.shading[a]));
+                each3!(|a| s.store_at(&mut sh[a], at, surf.shading[a]));
             }
             let (p, err, nn) = (&mut pts.p[bi], &mut pts.err[bi], &mut pts.normal[bi]);
             each3!(|a| {
-                s.store_at(&mut p[a], ai, at.p[a]);
-                s.store_at(&mut err[a], ai, at.err[a]);
-                s.store_at(&mut nn[a], ai, at.normal[a]);
+                s.store_at(&mut p[a], at, surf.p[a]);
+                s.store_at(&mut err[a], at, surf.err[a]);
+                s.store_at(&mut nn[a], at, surf.normal[a]);
             });
             if colour {
                 let rho = if varies {
                     let mut rho = [Vec3::ZERO; 8];
                     for (l, rho) in rho[..w].iter_mut().enumerate() {
-                        let j = o + l;
-                        *rho = self
-                            .scene
-                            .base_colour(g.tri[j], [g.b[0][j], g.b[1][j], g.b[2][j]]);
+                        let b = [bary[0][at + l], bary[1][at + l], bary[2][at + l]];
+                        *rho = self.scene.base_colour(ids[at + l], b);
                     }
                     each3!(|a| s.gather(|l| rho[l][a]))
                 } else if same {
@@ -401,7 +407,7 @@ impl Tracer<'_> {
                     each3!(|a| s.gather(|l| rho[l][a]))
                 };
                 let r = &mut pts.rho[bi];
-                each3!(|a| s.store_at(&mut r[a], ai, rho[a]));
+                each3!(|a| s.store_at(&mut r[a], at, rho[a]));
             }
         }
         let shadows = self.tile_shadows(s);
@@ -429,14 +435,18 @@ impl Tracer<'_> {
             let mut rgb = [[0f32; 8]; 3];
             each3!(|a| s.store(&mut rgb[a], colour[a]));
             let colour = |l: usize| Vec3::new(rgb[0][l], rgb[1][l], rgb[2][l]);
-            if count == 8 && g.idx[o + 7] as usize == o + 7 {
-                // Eight pixels in place (indices only grow): written in a row.
+            if count == 8 && o < placed {
+                // Eight pixels in place: written in a row.
                 for (l, out) in out[o..o + 8].iter_mut().enumerate() {
                     *out = colour(l);
                 }
             } else {
                 for l in 0..count {
-                    out[g.idx[o + l] as usize] = colour(l);
+                    let i = match o < placed {
+                        true => o + l,
+                        false => g.idx[o + l] as usize,
+                    };
+                    out[i] = colour(l);
                 }
             }
         }
