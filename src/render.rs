@@ -20,7 +20,7 @@ mod threads;
 
 use crate::accel::Hit;
 use crate::camera::{Camera, RayGen};
-use crate::denoise::{GuidePixel, Guides, denoise_on};
+use crate::denoise::{GuidePixel, Guides, denoised_image};
 use crate::geometry::Ray;
 use crate::image::Image;
 use crate::sampler::{Sampler, Stream};
@@ -312,7 +312,7 @@ fn render(scene: &Scene, options: &Options, cache: Option<&mut HitCache>) -> Fra
     };
     if let (Output::Denoised, Some(g)) = (options.output, &frame.guides) {
         let start = Instant::now();
-        frame.image = denoise_on(scene.isa(), g).image;
+        frame.image = denoised_image(scene.isa(), g);
         frame.stats.elapsed += start.elapsed();
     }
     frame

@@ -138,6 +138,24 @@ pub fn denoise(g: &Guides) -> Denoised {
 /// # Panics
 /// If this CPU does not have the path.
 pub fn denoise_on(isa: Isa, g: &Guides) -> Denoised {
+    let mut raw_error = 0.0;
+    let (image, e) = filter(isa, g, |e| raw_error = error_estimate(g, e));
+    Denoised {
+        image,
+        raw_error,
+        error: error_estimate(g, &e),
+    }
+}
+
+/// [`denoise_on`]'s image alone: a render shows no error estimate, and each is a pass over
+/// the frame on one thread.
+pub(crate) fn denoised_image(isa: Isa, g: &Guides) -> Image {
+    filter(isa, g, |_| {}).0
+}
+
+/// The denoised image, and the irradiance planes it came from; `unfiltered` sees them before
+/// the first pass (their variance is the raw image's).
+fn filter(isa: Isa, g: &Guides, unfiltered: impl FnOnce(&Planes)) -> (Image, Planes) {
     let (w, h) = (g.width as usize, g.height as usize);
     let surface = surface_planes(g);
     let stride = surface.stride();
@@ -166,7 +184,7 @@ pub fn denoise_on(isa: Isa, g: &Guides) -> Denoised {
                 out: row,
             })
         });
-    let raw_error = error_estimate(g, &e);
+    unfiltered(&e);
     let mut next = Planes::new(IRRADIANCE_PLANES, w, h);
     for i in 0..ITERATIONS {
         next.rows_mut().for_each(|(y, row)| {
@@ -180,8 +198,7 @@ pub fn denoise_on(isa: Isa, g: &Guides) -> Denoised {
         });
         std::mem::swap(&mut e, &mut next);
     }
-    restore(isa, g.samples, &surface, raw, &mut e, next);
-    let error = error_estimate(g, &e);
+    restore(isa, g.samples, &surface, &raw, &mut e, next);
     let mut pixels = vec![Vec3::ZERO; w * h];
     pixels
         .par_chunks_mut(w.max(1))
@@ -196,15 +213,12 @@ pub fn denoise_on(isa: Isa, g: &Guides) -> Denoised {
                 *o = p.rest + remodulate(p, f);
             }
         });
-    Denoised {
-        image: Image {
-            width: g.width,
-            height: g.height,
-            pixels,
-        },
-        raw_error,
-        error,
-    }
+    let image = Image {
+        width: g.width,
+        height: g.height,
+        pixels,
+    };
+    (image, e)
 }
 
 /// The guides' surfaces as planes. A key is the pixel's (reflections, object) pair numbered in
@@ -508,26 +522,14 @@ const SAME_NORMAL_COS: f32 = 0.957_603_3;
 /// channel is a Wiener factor `b²/(b² + var b·RESTORE_SAMPLES/samples)` of the window's mean
 /// difference `b`: about 1 where the difference is systematic (the filter's bias), about 0
 /// where it is noise (few samples, where handing it back would undo the filter).
-fn restore(isa: Isa, samples: u32, s: &Planes, mut raw: Planes, f: &mut Planes, mut share: Planes) {
+fn restore(isa: Isa, samples: u32, s: &Planes, raw: &Planes, f: &mut Planes, mut share: Planes) {
     let noise_weight = RESTORE_SAMPLES / samples.max(1) as f32;
-    let stride = s.stride();
-    // What the filter took from each pixel.
-    raw.rows_mut()
-        .zip(f.rows())
-        .for_each(|((_, row), (_, f_row))| {
-            for c in 0..3 {
-                for x in 0..s.width() {
-                    let i = in_row(stride, c, x);
-                    row[i] -= f_row[in_row(stride, E + c, x)];
-                }
-            }
-        });
-    let taken = raw;
     // What each pixel hands to each pixel of its window.
     share.rows_mut().for_each(|(y, row)| {
         isa.run(Share {
             s,
-            taken: &taken,
+            raw,
+            f,
             noise_weight,
             y,
             out: row,
@@ -547,13 +549,24 @@ fn restore(isa: Isa, samples: u32, s: &Planes, mut raw: Planes, f: &mut Planes, 
 const RESTORE_WINDOW: std::ops::RangeInclusive<isize> =
     -(RESTORE_RADIUS as isize)..=RESTORE_RADIUS as isize;
 
-/// What each pixel of row `y` hands to each pixel of its window (see [`restore`]).
+/// What each pixel of row `y` hands to each pixel of its window (see [`restore`]), from what
+/// the filter took from each pixel: its raw irradiance (`raw`) minus the filtered one (`f`).
+/// (Outside the frame that difference is not zero, but no pixel counts a neighbour there.)
 struct Share<'a> {
     s: &'a Planes,
-    taken: &'a Planes,
+    raw: &'a Planes,
+    f: &'a Planes,
     noise_weight: f32,
     y: usize,
     out: &'a mut [f32],
+}
+
+impl Share<'_> {
+    /// What the filter took from pixels (`x`, `y`) on.
+    #[inline(always)]
+    fn taken<L: Lanes>(&self, x: isize, y: isize) -> Lane3<L> {
+        self.raw.load3(0, x, y).sub(self.f.load3(E, x, y))
+    }
 }
 
 impl Kernel for Share<'_> {
@@ -571,7 +584,7 @@ impl Kernel for Share<'_> {
             for dy in RESTORE_WINDOW {
                 for dx in RESTORE_WINDOW {
                     let shares = q.shares(&Surface::at(s, x + dx, y + dy));
-                    let d = self.taken.load3(E, x + dx, y + dy);
+                    let d = self.taken::<L<P>>(x + dx, y + dy);
                     m1 = m1.add(d.counted(shares));
                     m2 = m2.add(d.mul(d).counted(shares));
                     n = n.add(counted(shares, L::<P>::splat(1.0)));
@@ -586,7 +599,7 @@ impl Kernel for Share<'_> {
             let b2 = b.mul(b);
             let total = b2.add(var_b);
             let k = total.zip(b2, |t, b2| L::<P>::select(t.gt(zero), zero, b2.div(t)));
-            let share = self.taken.load3(E, x, y).mul(k).div(n);
+            let share = self.taken::<L<P>>(x, y).mul(k).div(n);
             // A pixel is in its own window unless it is left out of the filter.
             share
                 .counted(n.gt(zero))
