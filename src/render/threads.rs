@@ -9,9 +9,9 @@ use crate::shading::RayCounts;
 /// The calling thread starts at once rather than waking the pool and waiting for it; a pool
 /// thread joins when it wakes (one that wakes after the work is gone returns at once). `work`
 /// shares the units out itself; it is told whether to take them from the back (the pool's
-/// threads) or the front (the calling thread): then the two ends of a new image, each in its
-/// own huge pages, are first touched (and zeroed by the kernel) by different threads at the
-/// same time, not one after the other. With one unit the pool is not used (nor started).
+/// threads) or the front (the calling thread): then the two ends of a new image are first
+/// touched (and zeroed by the kernel) by different threads at the same time, not one after the
+/// other. With one unit the pool is not used (nor started).
 pub(super) fn on_every_thread(units: usize, work: impl Fn(bool) -> RayCounts + Sync) -> RayCounts {
     if units <= 1 {
         return work(false);
