@@ -421,7 +421,7 @@ pub(super) fn intersect_tile_best<P: Path>(
     let TileCache {
         tris, best: all, ..
     } = cache;
-    all.clear(n);
+    all.clear();
     while kept != 0 {
         let t = &tris[kept.trailing_zeros() as usize];
         kept &= kept - 1;

@@ -274,15 +274,13 @@ impl BestTile {
         L::select(take, ids, L::splat(f32::from_bits(id))).store(&mut self.id[at..]);
     }
 
-    /// Makes rays `0..n` (rounded up to the widest lanes, 16) have no hit yet.
+    /// Makes every ray have no hit yet. (All of them, whatever the tile's size: stores of a
+    /// known length, not the calls to `memset` that a tile's own length took.)
     #[inline(always)]
-    pub fn clear(&mut self, n: usize) {
-        let n = n.next_multiple_of(16).min(TILE_RAYS);
-        self.t[..n].fill(f32::INFINITY);
-        for row in &mut self.b {
-            row[..n].fill(0.0);
-        }
-        self.id[..n].fill(f32::from_bits(u32::MAX));
+    pub fn clear(&mut self) {
+        self.t = [f32::INFINITY; TILE_RAYS];
+        self.b = [[0.0; TILE_RAYS]; 3];
+        self.id = [f32::from_bits(u32::MAX); TILE_RAYS];
     }
 
     /// Rays `8·p..8·p + 8` into `out`.
