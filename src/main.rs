@@ -13,17 +13,14 @@ fn main() -> std::process::ExitCode {
 
 /// Makes this thread one of rayon's (the pool keeps rayon's thread count: `RAYON_NUM_THREADS`,
 /// else the CPUs this process may use, this thread among them; nothing spins). A frame's
-/// parallel passes then start on this thread at once, and it takes part in them. From a thread
-/// outside the pool each pass (a denoised frame has ten) is handed over while this thread
-/// sleeps until it is done: two wake-ups on the frame's path per pass, each as slow as the
-/// scheduler (on an idle VM, a halted virtual CPU's). Stage 6 denoised at 200×100, medians of
-/// interleaved runs on a loaded machine at real-time priority: 7.63 -> 7.46 ms on 2 threads,
-/// 13.68 -> 13.25 on 1; `raytty bench --sizes 200x100` switches threads 3335 -> 1225 times.
-/// (Real-time priority hides the schedulers' wake-up latency, which is what this saves: on the
-/// quiet machine the row took 10.66 ms with the hand-overs, against 8.15 at b36ea05, whose
-/// thread was one of rayon's.) This thread runs the pool's work only while it is in a rayon
-/// call, and with one thread it is the whole pool: no other thread may call rayon while this
-/// one waits outside it (the app's reader, writer and signal threads only do I/O).
+/// parallel passes then start on this thread at once; from a thread outside the pool each pass
+/// (a denoised frame has ten) is handed over, and this thread sleeps until it is done: two
+/// wake-ups on the frame's path per pass. Stage 6 denoised at 200×100, `raytty bench`, medians
+/// of 5 interleaved rounds on the quiet 2-core VM, without → with: 11.12 → 8.00 ms (another
+/// sitting of 4 rounds: 10.04 → 9.80); thread switches of the 200×100 bench 3335 → 1225.
+/// This thread runs the pool's work only while it is in a rayon call, and with one thread it
+/// is the whole pool: no other thread may call rayon while this one waits outside it (the
+/// app's reader, writer and signal threads only do I/O).
 fn join_the_pool() {
     // It fails only if a pool was built before, and nothing builds one before `main`.
     let built = rayon::ThreadPoolBuilder::new()
