@@ -605,10 +605,15 @@ impl Tracer<'_> {
             let on = s.lanes(on);
             let (bi, ai) = (c * w / 8, c * w % 8);
             let (sum, term) = (&mut pts.sum[bi], &pts.term[bi]);
+            // The term added where `on`, +0 elsewhere: the same bits as keeping the sum there
+            // (a sum starts at +0 and adds terms of +0 or more, so it is never −0, the one
+            // value +0 changes). Not `select(on, v + t, v)`: stored back, that blend of the
+            // sum's own lanes becomes a masked store (see `F8::store_whole`).
+            let zero = s.splat(0.0);
             each3!(|a| {
                 let v = s.load_at(&sum[a], ai);
                 let t = s.load_at(&term[a], ai);
-                s.store_at(&mut sum[a], ai, s.select(on, s.add(v, t), v));
+                s.store_at(&mut sum[a], ai, s.add(v, s.select(on, t, zero)));
             });
         }
     }

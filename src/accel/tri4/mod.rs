@@ -265,13 +265,13 @@ impl BestTile {
     fn fold<L: Lanes>(&mut self, at: usize, hit: L::Mask, t: L, b: [L; 3], id: u32) {
         let best_t = L::load(&self.t[at..]);
         let take = L::and(hit, t.lt(best_t));
-        L::select(take, best_t, t).store(&mut self.t[at..]);
+        L::select(take, best_t, t).store_whole(&mut self.t[at..]);
         for (k, w) in b.into_iter().enumerate() {
             let row = &mut self.b[k][at..];
-            L::select(take, L::load(row), w).store(row);
+            L::select(take, L::load(row), w).store_whole(row);
         }
         let ids = L::load(&self.id[at..]);
-        L::select(take, ids, L::splat(f32::from_bits(id))).store(&mut self.id[at..]);
+        L::select(take, ids, L::splat(f32::from_bits(id))).store_whole(&mut self.id[at..]);
     }
 
     /// Makes every ray have no hit yet. (All of them, whatever the tile's size: stores of a
