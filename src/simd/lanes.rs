@@ -354,9 +354,9 @@ mod x86 {
         /// thread, `perf record` over 30 renders of the 500×500 seed frame) the frame's own
         /// code took 17 % fewer samples; `raytty bench`'s seed row, 2 threads, medians of 5
         /// interleaved rounds: 6.10 → 4.94 ms. Same frames.
-        #[inline(always)]
         // The block reads and writes no memory: it only hides where the pointer came from.
         #[allow(clippy::pointers_in_nomem_asm_block)]
+        #[inline(always)]
         fn store_whole(self, a: &mut [f32]) {
             let mut to = a[..F8::N].as_mut_ptr();
             unsafe {
