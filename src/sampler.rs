@@ -14,7 +14,9 @@
 //!
 //! Samples of a pixel are points `frame·samples + sample` of one sequence: a frame of N samples
 //! continues where the previous frame stopped, so progressive passes (the app's) and one batch
-//! draw the same points, and any prefix of a power-of-two length is a well-spread net.
+//! draw the same points, and any prefix of a power-of-two length is a well-spread net. Where a
+//! path splits into k branches after its first vertex, branch b of point i draws from point
+//! `i·k + b` (from its first bounce on), so the branches of N samples spread over kN points.
 
 use crate::rng::{Rng, mix};
 
@@ -54,9 +56,20 @@ pub trait SampleSource {
     fn next_1d(&mut self) -> f32;
     /// The next pair.
     fn next_2d(&mut self) -> [f32; 2];
+    /// The numbers of branch `b` of `k` that a path splits into after its first vertex,
+    /// from the path's first bounce on.
+    fn branch(&self, b: u32, k: u32) -> Self
+    where
+        Self: Sized;
 }
 
 impl SampleSource for Rng {
+    /// A generator of its own, seeded from this one's next number and `b`.
+    fn branch(&self, b: u32, _k: u32) -> Rng {
+        let next = self.clone().next_u64();
+        Rng::seeded(mix(next ^ u64::from(b + 1).wrapping_mul(BRANCH_KEY)))
+    }
+
     #[inline]
     fn next_1d(&mut self) -> f32 {
         self.next_f32()
@@ -110,6 +123,13 @@ impl Stream {
 }
 
 impl SampleSource for Stream {
+    fn branch(&self, b: u32, k: u32) -> Stream {
+        match self {
+            Stream::Independent(r) => Stream::Independent(r.branch(b, k)),
+            Stream::Sobol(s) => Stream::Sobol(s.branch(b, k)),
+        }
+    }
+
     #[inline]
     fn next_1d(&mut self) -> f32 {
         match self {
@@ -126,6 +146,10 @@ impl SampleSource for Stream {
         }
     }
 }
+
+/// Keeps the streams of an independent path's branches apart from each other and from its
+/// own (any odd constant: the first 64 bits of √2's fraction, its last bit set).
+const BRANCH_KEY: u64 = 0x6A09_E667_F3BC_C909;
 
 /// The Sobol sampler's dimension (pair) of the pixel offset; a path's draws come after it.
 const PIXEL_DIMENSION: u32 = 0;
@@ -192,6 +216,18 @@ impl Sobol {
 }
 
 impl SampleSource for Sobol {
+    /// Point `index·k + b` of the pixel's sequence, from its first draw on: the k branches of
+    /// a pixel's N samples are together the first kN points, so each pair a branch draws is
+    /// spread over all of them.
+    fn branch(&self, b: u32, k: u32) -> Sobol {
+        let index = self.index_reversed.reverse_bits();
+        Sobol {
+            key: self.key,
+            index_reversed: index.wrapping_mul(k).wrapping_add(b).reverse_bits(),
+            dimension: PIXEL_DIMENSION + 1,
+        }
+    }
+
     /// The first coordinate of the next pair (the second is not computed).
     #[inline]
     fn next_1d(&mut self) -> f32 {

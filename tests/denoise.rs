@@ -234,8 +234,11 @@ fn the_area_lit_box_is_denoised() {
     let [raw, den] = raw_and_denoised(&scene, w, h, 2).map(|i| clamped(&i));
     let (e_raw, e_den) = (rmse(&raw, &reference), rmse(&den, &reference));
     eprintln!("area {w}x{h} 2 spp (clamped): raw {e_raw:.4}, denoised {e_den:.4}");
+    // Raw 0.0747 and denoised 0.0390 while a sample traced one path; since a diffuse first
+    // hit sends two on (in frames of several samples), raw 0.0541 and denoised 0.0340: both
+    // better, the raw frame most.
     assert!(
-        e_den < 0.6 * e_raw,
+        e_den < 0.7 * e_raw,
         "denoised {e_den:.4} is not well below raw {e_raw:.4}"
     );
     let glass = builtin::find("glass").unwrap().load().unwrap();

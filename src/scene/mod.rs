@@ -85,6 +85,11 @@ impl Material {
         }
     }
 
+    /// Whether the surface only scatters diffusely: no mirror, metal or glass part.
+    pub fn only_diffuse(&self) -> bool {
+        self.mirror == 0.0 && self.metal == 0.0 && self.transmission == 0.0
+    }
+
     /// Whether the surface emits light.
     pub fn emits(&self) -> bool {
         self.emission.max_element() > 0.0

@@ -211,7 +211,7 @@ impl<'a> Tracer<'a> {
             // brings is its colour times an irradiance, which the denoiser filters (soft
             // shadows and bounces alike). A mirror, metal or glass first hit keeps all its
             // light as it is: a filter on the surface would blur what it reflects.
-            if material.mirror > 0.0 || material.metal > 0.0 || material.transmission > 0.0 {
+            if !material.only_diffuse() {
                 return SplitSample {
                     rest: c.sum(),
                     guide,
