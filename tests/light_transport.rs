@@ -289,6 +289,33 @@ fn effects_are_what_the_scene_calls_for() {
     assert!(s.path.is_none());
 }
 
+/// A scene that scatters only diffusely (the area-lit box) sends two paths on from the first
+/// vertex in a frame of several samples: with no bounce past the first (so that each path
+/// traces one bounce ray), twice the bounce rays a sample; a frame of one sample, and a scene
+/// with glass (whose noise is elsewhere), one path.
+#[test]
+fn only_a_diffuse_scene_splits_its_first_vertex_and_only_with_several_samples() {
+    let per_sample = |name: &str, spp: u32| {
+        let scene = builtin::find(name).unwrap().load().unwrap();
+        let mut s = gi(spp, 0, Estimator::Auto);
+        s.effects.indirect = Indirect::PathTraced { bounces: 0 };
+        let rays = scene
+            .render(&Options {
+                width: 32,
+                height: 20,
+                settings: Some(s),
+                ..Options::default()
+            })
+            .stats
+            .rays;
+        rays.bounce as f64 / rays.primary as f64
+    };
+    let (one, two) = (per_sample("area", 1), per_sample("area", 2));
+    assert!(one > 0.5 && (two / one - 2.0).abs() < 0.1, "{one} {two}");
+    let (one, two) = (per_sample("glass", 1), per_sample("glass", 2));
+    assert!(one > 0.5 && (two / one - 1.0).abs() < 0.1, "{one} {two}");
+}
+
 /// No area-light shadow ray without emitting triangles, none with BSDF sampling alone; a scene
 /// of point lights and metal traces one per point light and vertex that the light reaches.
 #[test]

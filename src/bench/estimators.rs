@@ -53,9 +53,10 @@ pub struct EstimatorRow {
     pub runs: u32,
     /// Rays per frame, by kind.
     pub rays: RayCounts,
-    /// RMSE against the reference.
+    /// RMSE against the reference, of values clamped to `0..=1` ([`metrics::shown`]).
     pub rmse: f64,
-    /// RMSE of 10×10-pixel block means against the reference (bias shows here, noise less).
+    /// RMSE of 10×10-pixel block means against the reference (bias shows here, noise less),
+    /// of values clamped to `0..=1`.
     pub block_rmse: f64,
 }
 
@@ -91,7 +92,7 @@ pub fn run(
         let spp = options.ref_spp.saturating_mul(REFERENCE_FACTOR);
         let spec = ReferenceSpec::new(scene, width, height, spp, GI_MAX_BOUNCES);
         let (img, info) = reference::load_or_render(scene, &spec, &options.cache_dir, progress)?;
-        images.push(img);
+        images.push(metrics::shown(&img));
         references.push(info);
     }
     let spps: Vec<u32> = SPP
@@ -138,6 +139,7 @@ pub fn run(
                     || progress.advance(u64::from(spp)),
                 );
                 let frame = kept.expect("measured at least once");
+                let shown = metrics::shown(&frame.image);
                 rows.push(EstimatorRow {
                     scene: scene.name().to_string(),
                     effects: frame.stats.effect_names(),
@@ -149,8 +151,8 @@ pub fn run(
                     median_ms: ms(timing.median()),
                     runs: timing.runs(),
                     rays: frame.stats.rays,
-                    rmse: metrics::rmse(&frame.image, reference),
-                    block_rmse: metrics::block_rmse(&frame.image, reference, 10),
+                    rmse: metrics::rmse(&shown, reference),
+                    block_rmse: metrics::block_rmse(&shown, reference, 10),
                 });
             }
         }

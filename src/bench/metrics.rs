@@ -57,6 +57,21 @@ pub fn block_rmse(a: &Image, b: &Image, block: u32) -> f64 {
     if n == 0 { 0.0 } else { (sum / n as f64).sqrt() }
 }
 
+/// The image as a display shows it: every value clamped to `0..=1`. Errors of scenes whose
+/// lights are in view are measured on it: an emitter's own pixels (values ~20) and their
+/// anti-aliased edges would otherwise outweigh the rest of the frame.
+pub fn shown(img: &Image) -> Image {
+    Image {
+        width: img.width,
+        height: img.height,
+        pixels: img
+            .pixels
+            .iter()
+            .map(|p| p.clamp(glam::Vec3::ZERO, glam::Vec3::ONE))
+            .collect(),
+    }
+}
+
 /// Peak signal-to-noise ratio of the 8-bit images (clamped, no gamma, as displayed), in dB:
 /// `10·log10(255²/MSE)`. Infinite when the 8-bit images are equal.
 pub fn psnr8(a: &Image, b: &Image) -> f64 {

@@ -256,3 +256,28 @@ fn the_second_dimension_follows_its_direction_numbers() {
         );
     }
 }
+
+/// Branch b of k of point i draws, from its first draw on, what point i·k + b draws: the
+/// branches of a pixel's N samples are the first kN points, every pair of them a net.
+#[test]
+fn branches_are_the_points_between() {
+    let (pixel, k) = (77, 2);
+    let mut branches = vec![];
+    for i in 0..32 {
+        for b in 0..k {
+            let mut branch = Sobol::new(pixel, i).branch(b, k);
+            let mut point = Sobol::new(pixel, i * k + b);
+            for _ in 0..6 {
+                let p = branch.next_2d();
+                assert_eq!(p, point.next_2d());
+                assert_eq!(branch.next_1d(), point.next_1d());
+            }
+            branches.push(Sobol::new(pixel, i).branch(b, k).next_2d());
+        }
+    }
+    assert_eq!(t_value(&branches, 6), 0);
+    // Independent numbers: each branch a stream of its own, none the path's.
+    let r = Rng::for_sample(3, 4, 5);
+    let [a, b] = [0, 1].map(|b| r.branch(b, 2).next_f32());
+    assert!(a != b && a != r.clone().next_f32() && b != r.clone().next_f32());
+}

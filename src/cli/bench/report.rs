@@ -315,7 +315,9 @@ pub fn estimator_markdown(rows: &[EstimatorRow], refs: &[ReferenceInfo]) -> Stri
         s,
         "The physically based effects, each by light sampling alone, BSDF sampling alone and \
          MIS (the hidden `render --estimator`), raw and denoised, at {}x{}, against each scene's reference \
-         (block RMSE: of 10x10-pixel means; time × RMSE²: lower is more accuracy per second):\n",
+         (values clamped to 0..1, as a display shows them: the lights' own pixels, ~20, \
+         would otherwise outweigh the rest; block RMSE: of 10x10-pixel means; time × RMSE²: \
+         lower is more accuracy per second):\n",
         first.width, first.height
     );
     let mut table = Table::new([
