@@ -32,6 +32,9 @@ fn guided(scene: &Scene, s: &Settings, w: u32, h: u32) -> Guides {
         .unwrap()
 }
 
+/// Floats a pixel takes in a cached file.
+const PIXEL_FLOATS: usize = 21;
+
 /// Guides as raw little-endian floats (`GUIDES=DIR` caches them, so that changes to the
 /// filter are measured on the same samples without rendering them again).
 fn save(g: &Guides, path: &str) {
@@ -49,6 +52,7 @@ fn save(g: &Guides, path: &str) {
             }
             None => out.extend([0.0; 9]),
         }
+        out.push(if p.mixed { 1.0 } else { 0.0 });
     }
     let bytes: Vec<u8> = out.iter().flat_map(|v| v.to_le_bytes()).collect();
     std::fs::write(path, bytes).unwrap();
@@ -61,8 +65,12 @@ fn load(path: &str) -> Option<Guides> {
         .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
         .collect();
     let v3 = |s: &[f32]| glam::Vec3::new(s[0], s[1], s[2]);
+    // A file of another layout is rendered again.
+    if v.len() < 3 || v.len() != 3 + PIXEL_FLOATS * (v[0] * v[1]) as usize {
+        return None;
+    }
     let pixels = v[3..]
-        .chunks_exact(20)
+        .chunks_exact(PIXEL_FLOATS)
         .map(|c| GuidePixel {
             rest: v3(&c[0..]),
             albedo: v3(&c[3..]),
@@ -74,6 +82,8 @@ fn load(path: &str) -> Option<Guides> {
                 object: c[18] as u32,
                 reflections: c[19] as u32,
             }),
+            mixed: c[20] == 1.0,
+            seen: true,
         })
         .collect();
     Some(Guides {

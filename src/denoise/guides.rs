@@ -3,6 +3,7 @@
 
 use glam::Vec3;
 
+use super::SAME_NORMAL_COS;
 use crate::shading::{GuideHit, SplitSample};
 
 /// One pixel's samples, summed (see [`GuidePixel::add`]) or averaged ([`Guides`] holds means).
@@ -20,6 +21,16 @@ pub struct GuidePixel {
     pub moments: [f32; 2],
     /// The first sample's guide surface (`None`: it saw the background).
     pub guide: Option<GuideHit>,
+    /// Whether the pixel's samples saw more than one surface (an edge or a silhouette runs
+    /// through it; see [`same_surface`]). The spread of such a pixel's samples is mostly the
+    /// two surfaces' difference, which its jittered samples average well, not noise. Filtered
+    /// like the rest, it was pulled towards one side and the difference handed to its
+    /// neighbours, a bias along every edge that more samples did not take away; so the
+    /// denoiser keeps it out of the restore and moves it back towards its raw value as samples
+    /// grow.
+    pub mixed: bool,
+    /// Whether a sample has been added (the guide is the first one's).
+    pub seen: bool,
 }
 
 impl GuidePixel {
@@ -32,8 +43,11 @@ impl GuidePixel {
         let l = luminance(s.irradiance);
         self.moments[0] += l;
         self.moments[1] += l * l;
-        if self.guide.is_none() {
+        if !self.seen {
             self.guide = s.guide;
+            self.seen = true;
+        } else if !same_surface(self.guide, s.guide) {
+            self.mixed = true;
         }
     }
 
@@ -95,11 +109,26 @@ impl Guides {
                 p.moments[0] * a + q.moments[0] * b,
                 p.moments[1] * a + q.moments[1] * b,
             ];
-            if p.guide.is_none() {
-                p.guide = q.guide;
+            if old == 0 {
+                (p.guide, p.mixed) = (q.guide, q.mixed);
+            } else {
+                p.mixed |= q.mixed || !same_surface(p.guide, q.guide);
             }
         }
         self.samples = total;
+    }
+}
+
+/// Whether two samples' guides are one surface: both the background, or the same object seen
+/// after as many mirrors, with normals within the restore's [`SAME_NORMAL_COS`] (about 17°).
+pub(crate) fn same_surface(a: Option<GuideHit>, b: Option<GuideHit>) -> bool {
+    match (a, b) {
+        (None, None) => true,
+        (Some(a), Some(b)) => {
+            (a.object, a.reflections) == (b.object, b.reflections)
+                && a.normal.dot(b.normal) >= SAME_NORMAL_COS
+        }
+        _ => false,
     }
 }
 
@@ -119,7 +148,7 @@ mod tests {
             albedo: Vec3::ONE,
             indirect: Vec3::splat(v),
             moments: [v, v * v],
-            guide: None,
+            ..GuidePixel::default()
         };
         Guides {
             width: 1,
@@ -142,5 +171,63 @@ mod tests {
         assert_eq!(g.samples, 2);
         assert_eq!(g.pixels[0].indirect, Vec3::splat(2.0));
         assert_eq!(g.pixels[0].rest, Vec3::splat(3.0));
+    }
+
+    fn hit(object: u32, normal: Vec3) -> Option<GuideHit> {
+        Some(GuideHit {
+            position: Vec3::ZERO,
+            normal,
+            object,
+            reflections: 0,
+        })
+    }
+
+    fn pixel_of(guides: &[Option<GuideHit>]) -> GuidePixel {
+        let mut p = GuidePixel::default();
+        for &guide in guides {
+            p.add(&SplitSample {
+                guide,
+                ..SplitSample::default()
+            });
+        }
+        p
+    }
+
+    #[test]
+    fn a_pixel_whose_samples_see_two_surfaces_is_mixed() {
+        let (up, side) = (Vec3::Y, Vec3::X);
+        // 10° apart: one curved surface.
+        let near = Vec3::new(10f32.to_radians().sin(), 10f32.to_radians().cos(), 0.0);
+        assert!(!pixel_of(&[hit(1, up), hit(1, up), hit(1, near)]).mixed);
+        assert!(!pixel_of(&[None, None]).mixed);
+        assert!(pixel_of(&[hit(1, up), hit(2, up)]).mixed, "two objects");
+        assert!(pixel_of(&[hit(1, up), hit(1, side)]).mixed, "a crease");
+        assert!(pixel_of(&[None, hit(1, up)]).mixed, "a silhouette");
+        assert!(pixel_of(&[hit(1, up), None]).mixed, "a silhouette");
+        let mut reflected = hit(1, up);
+        reflected.as_mut().unwrap().reflections = 1;
+        assert!(pixel_of(&[hit(1, up), reflected]).mixed, "a mirror's edge");
+        // The guide stays the first sample's, the background included.
+        assert_eq!(pixel_of(&[None, hit(1, up)]).guide, None);
+        // Frames folded together: a pixel is mixed if either frame's is, or their surfaces
+        // differ.
+        let frame = |p: GuidePixel| Guides {
+            width: 1,
+            height: 1,
+            samples: 1,
+            pixels: vec![p],
+        };
+        let mut g = frame(pixel_of(&[hit(1, up)]));
+        g.accumulate(&frame(pixel_of(&[hit(1, up)])), u32::MAX);
+        assert!(!g.pixels[0].mixed);
+        g.accumulate(&frame(pixel_of(&[hit(2, up)])), u32::MAX);
+        assert!(g.pixels[0].mixed);
+        let mut g = frame(GuidePixel::default());
+        g.samples = 0;
+        g.accumulate(&frame(pixel_of(&[hit(1, up), hit(2, up)])), u32::MAX);
+        assert!(
+            g.pixels[0].mixed,
+            "an empty history takes the new frame's pixel"
+        );
     }
 }

@@ -113,12 +113,14 @@ pub struct Denoised {
 
 /// The guide surface's planes (see [`Planes`]): normal, position, the key (object and
 /// reflection count, as a number only equal pixels share; NaN for a pixel left out of the
-/// filter, which no pixel equals), and the irradiance's luminance moments.
+/// filter, which no pixel equals), the irradiance's luminance moments, and 1 where the pixel is
+/// [`GuidePixel::mixed`] (else 0).
 const NX: usize = 0;
 const PX: usize = 3;
 const KEY: usize = 6;
 const MOMENT: usize = 7;
-const SURFACE_PLANES: usize = 9;
+const MIXED: usize = 9;
+const SURFACE_PLANES: usize = 10;
 
 /// The planes a pass reads and writes: the irradiance, its variance, its luminance.
 const E: usize = 0;
@@ -199,17 +201,22 @@ fn filter(isa: Isa, g: &Guides, unfiltered: impl FnOnce(&Planes)) -> (Image, Pla
         std::mem::swap(&mut e, &mut next);
     }
     restore(isa, g.samples, &surface, &raw, &mut e, next);
+    // A mixed pixel takes no part in the restore; it goes back towards its raw value by its
+    // samples' count: half way at RESTORE_SAMPLES, all the way in the limit.
+    let back = samples / (samples + RESTORE_SAMPLES);
     let mut pixels = vec![Vec3::ZERO; w * h];
     pixels
         .par_chunks_mut(w.max(1))
         .zip(e.rows())
-        .for_each(|(out, (y, row))| {
+        .zip(raw.rows())
+        .for_each(|((out, (y, row)), (_, raw_row))| {
             for (x, (o, p)) in out.iter_mut().zip(&g.pixels[y * w..]).enumerate() {
-                let f = Vec3::new(
-                    row[in_row(stride, E, x)],
-                    row[in_row(stride, E + 1, x)],
-                    row[in_row(stride, E + 2, x)],
-                );
+                let at = |plane: &[f32], c| plane[in_row(stride, c, x)];
+                let mut f = Vec3::new(at(row, E), at(row, E + 1), at(row, E + 2));
+                if p.mixed {
+                    let r = Vec3::new(at(raw_row, 0), at(raw_row, 1), at(raw_row, 2));
+                    f += back * (r - f);
+                }
                 *o = p.rest + remodulate(p, f);
             }
         });
@@ -231,7 +238,7 @@ fn surface_planes(g: &Guides) -> Planes {
         .pixels
         .iter()
         .map(|p| {
-            let Some(guide) = p.guide.filter(|_| p.albedo.max_element() >= MIN_ALBEDO) else {
+            let Some(guide) = p.guide.filter(|_| !left_out(p)) else {
                 return f32::NAN;
             };
             let key = (guide.reflections, guide.object);
@@ -254,6 +261,7 @@ fn surface_planes(g: &Guides) -> Planes {
             let (p, key) = (&g.pixels[y * w + x], keys[y * w + x]);
             row[in_row(stride, MOMENT, x)] = p.moments[0];
             row[in_row(stride, MOMENT + 1, x)] = p.moments[1];
+            row[in_row(stride, MIXED, x)] = if p.mixed { 1.0 } else { 0.0 };
             if let Some(guide) = p.guide.filter(|_| !key.is_nan()) {
                 for c in 0..3 {
                     row[in_row(stride, NX + c, x)] = guide.normal[c];
@@ -264,6 +272,12 @@ fn surface_planes(g: &Guides) -> Planes {
         }
     });
     s
+}
+
+/// Whether the filter leaves pixel `p` raw: it saw the background, or its albedo is too small
+/// to divide by.
+fn left_out(p: &GuidePixel) -> bool {
+    p.guide.is_none() || p.albedo.max_element() < MIN_ALBEDO
 }
 
 /// The pixel's indirect irradiance: its indirect light divided by its albedo, per channel
@@ -280,7 +294,7 @@ fn demodulate(p: &GuidePixel) -> Vec3 {
 /// The indirect light from a filtered irradiance `f`: `albedo·f`, with the raw indirect
 /// light kept in channels that were not demodulated.
 fn remodulate(p: &GuidePixel, f: Vec3) -> Vec3 {
-    if p.guide.is_none() || p.albedo.max_element() < MIN_ALBEDO {
+    if left_out(p) {
         return p.indirect;
     }
     let r = |i: f32, a: f32, f: f32| if a >= MIN_ALBEDO { a * f } else { i };
@@ -297,6 +311,8 @@ struct Surface<L: Lanes> {
     key: L,
     normal: Lane3<L>,
     position: Lane3<L>,
+    /// 1 where the pixel is [`GuidePixel::mixed`], else 0.
+    mixed: L,
 }
 
 impl<L: Lanes> Surface<L> {
@@ -306,6 +322,7 @@ impl<L: Lanes> Surface<L> {
             key: s.load(KEY, x, y),
             normal: s.load3(NX, x, y),
             position: s.load3(PX, x, y),
+            mixed: s.load(MIXED, x, y),
         }
     }
 
@@ -338,14 +355,19 @@ impl<L: Lanes> Surface<L> {
 
     /// Whether `q` counts as this pixel's neighbour for the restore: the same object seen
     /// through the same mirrors, normals within about 17°, and each in the other's plane as
-    /// far as [`Surface::weight`]'s plane term counts it at least half. Symmetric in the two
-    /// pixels (what one hands to the other is what the other counts), without a square root
-    /// or a division.
+    /// far as [`Surface::weight`]'s plane term counts it at least half; neither of them
+    /// mixed (a mixed pixel goes back towards its raw value on its own: see [`filter`]).
+    /// Symmetric in the two pixels (what one hands to the other is what the other counts),
+    /// without a square root or a division.
     #[inline(always)]
     fn shares(&self, q: &Self) -> L::Mask {
-        let near = L::andnot(
-            self.normal.dot(q.normal).lt(L::splat(SAME_NORMAL_COS)),
-            self.key.eq(q.key),
+        let whole = self.mixed.add(q.mixed).eq(L::splat(0.0));
+        let near = L::and(
+            whole,
+            L::andnot(
+                self.normal.dot(q.normal).lt(L::splat(SAME_NORMAL_COS)),
+                self.key.eq(q.key),
+            ),
         );
         let step = q.position.sub(self.position);
         let half = 0.5 * PLANE_COS;
