@@ -110,7 +110,7 @@ impl Guides {
                 p.moments[1] * a + q.moments[1] * b,
             ];
             if old == 0 {
-                (p.guide, p.mixed) = (q.guide, q.mixed);
+                (p.guide, p.mixed, p.seen) = (q.guide, q.mixed, q.seen);
             } else {
                 p.mixed |= q.mixed || !same_surface(p.guide, q.guide);
             }
@@ -121,7 +121,7 @@ impl Guides {
 
 /// Whether two samples' guides are one surface: both the background, or the same object seen
 /// after as many mirrors, with normals within the restore's [`SAME_NORMAL_COS`] (about 17°).
-pub(crate) fn same_surface(a: Option<GuideHit>, b: Option<GuideHit>) -> bool {
+fn same_surface(a: Option<GuideHit>, b: Option<GuideHit>) -> bool {
     match (a, b) {
         (None, None) => true,
         (Some(a), Some(b)) => {
