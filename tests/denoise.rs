@@ -105,8 +105,8 @@ fn with_many_samples_the_denoised_frame_is_as_right_as_the_raw_one_in_blocks() {
 
 /// The goal on every built-in scene, at the size: at 1024 spp
 /// the denoised RMSE is no worse than raw, from 256 spp its block RMSE is at most 1.25× raw's
-/// (against 4096-spp references of independent numbers; several minutes: `cargo test --release --test denoise --
-/// --ignored`). "No worse" allows `TIE`: on glass the filter leaves most of the noise alone
+/// (against 4096-spp references of independent numbers; several minutes:
+/// `cargo test --release --test denoise -- --ignored`). "No worse" allows `TIE`: on glass the filter leaves most of the noise alone
 /// (the caustics are sharp light, kept apart from the filtered part), and what it changes
 /// gains and loses about equally (160×100, 1024 spp, against Mitsuba's 16384-spp frame: the
 /// squared error of the 9,020 pixels it changes −0.228 where better, +0.236 where worse; RMSE
